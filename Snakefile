@@ -1,0 +1,18 @@
+# PlanIT pipeline. Run: snakemake --cores 2   (profiles/default is picked up automatically)
+from snakemake.utils import min_version
+
+min_version("9.0")
+
+
+configfile: "config/config.yaml"
+
+
+include: "rules/common.smk"
+include: "rules/ingest.smk"
+include: "rules/extract.smk"
+
+
+rule all:
+    input:
+        get_final_outputs(),
+    default_target: True

@@ -1,0 +1,102 @@
+"""Shared test helpers: hand-built rooms as canonical rows, and a real extraction call."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline import config as config_mod
+from pipeline.extraction import extract_room
+from pipeline.geometry import meshes
+from pipeline.geometry.polygon import polygon_segments
+from pipeline.geometry.raycast import intersector_class
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED_DATA = ROOT.parent / "shared" / "data"
+
+
+class Room:
+    """A room built by hand: outline, walls, openings, box-mesh or custom-mesh objects."""
+
+    def __init__(self, outline, height=2.7, room_id="r0", room_type="bedroom"):
+        self.outline = np.asarray(outline, float)
+        self.height = height
+        self.room_id = room_id
+        self.room_type = room_type
+        self.objects: list[dict] = []
+        self.models: dict[str, tuple] = {}
+        self.openings: list[dict] = []
+
+    def add(self, object_id, category, size, centre_xy, yaw_deg=0.0, z=0.0, mesh=None, parent=None):
+        """Object of full ``size`` (w, d, h) standing at height ``z``; its mesh is a box unless given."""
+        w, d, h = size
+        model_id = f"m_{object_id}"
+        self.models[model_id] = mesh if mesh is not None else meshes.box((w, d, h), (0, 0, h / 2))
+        yaw = math.radians(yaw_deg)
+        self.objects.append({"room_id": self.room_id, "object_id": object_id, "category": category, "model_id": model_id,
+                             "cx": centre_xy[0], "cy": centre_xy[1], "cz": z + h / 2, "hx": w / 2, "hy": d / 2, "hz": h / 2,
+                             "yaw": yaw, "px": centre_xy[0], "py": centre_xy[1], "pz": z, "sx": 1.0, "sy": 1.0, "sz": 1.0,
+                             "source_parent_id": parent})
+        return self
+
+    def door(self, element_id, p0, p1, wall_id):
+        self.openings.append({"room_id": self.room_id, "element_id": element_id, "kind": "door", "x0": p0[0], "y0": p0[1],
+                              "x1": p1[0], "y1": p1[1], "z0": 0.0, "z1": 2.0, "thickness": None, "wall_id": wall_id})
+        return self
+
+    def walls(self) -> pd.DataFrame:
+        segs = polygon_segments(self.outline)
+        return pd.DataFrame([{"room_id": self.room_id, "element_id": f"wall_{i}", "kind": "wall", "x0": s[0][0], "y0": s[0][1],
+                              "x1": s[1][0], "y1": s[1][1], "z0": 0.0, "z1": self.height, "thickness": 0.15, "wall_id": None}
+                             for i, s in enumerate(segs)])
+
+    def row(self):
+        xs, ys = self.outline[:, 0], self.outline[:, 1]
+        return SimpleNamespace(room_id=self.room_id, room_type=self.room_type, height=self.height, floor_x=xs.tolist(),
+                               floor_y=ys.tolist(), extent_x=float(np.ptp(xs)), extent_y=float(np.ptp(ys)))
+
+    def objects_df(self) -> pd.DataFrame:
+        cols = ["room_id", "object_id", "category", "model_id", "cx", "cy", "cz", "hx", "hy", "hz", "yaw", "px", "py", "pz",
+                "sx", "sy", "sz", "source_parent_id"]
+        return pd.DataFrame(self.objects, columns=cols)
+
+    def openings_df(self) -> pd.DataFrame:
+        cols = ["room_id", "element_id", "kind", "x0", "y0", "x1", "y1", "z0", "z1", "thickness", "wall_id"]
+        return pd.DataFrame(self.openings, columns=cols)
+
+    def extract(self, backend="embree", symmetry=None, cfg=None):
+        cfg = cfg or default_config()["extract"]
+        symmetry = symmetry or {}
+        return extract_room(self.row(), self.walls(), self.openings_df(), self.objects_df(), self.models.get,
+                            lambda c, m: (symmetry.get(c, "none"), "table"), cfg, intersector_class(backend))
+
+
+def default_config() -> dict:
+    return config_mod.validate({})
+
+
+def edges_df(graph) -> pd.DataFrame:
+    return pd.DataFrame(graph.edges)
+
+
+def edge(graph, src, dst, edge_type="spatial"):
+    """The one edge src -> dst of a type, or None."""
+    e = [x for x in graph.edges if x["source"] == src and x["target"] == dst and x["edge_type"] == edge_type]
+    assert len(e) <= 1
+    return e[0] if e else None
+
+
+@pytest.fixture
+def rect_room():
+    return Room([[0, 0], [5, 0], [5, 4], [0, 4]])
+
+
+def shared_data(sub: str) -> Path:
+    path = SHARED_DATA / sub
+    if not path.exists():
+        pytest.skip(f"real sample data not found at {path} (a fresh clone has no ../shared; see tests/README)")
+    return path

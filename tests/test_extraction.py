@@ -1,0 +1,174 @@
+"""Hand-built rooms with known answers, checked edge by edge against real Embree ray casts."""
+import math
+
+import numpy as np
+import pytest
+
+from pipeline.corpus import catalog
+from pipeline.geometry import meshes, relations
+from conftest import Room, default_config, edge
+
+DIST = default_config()["extract"]["distance"]
+
+
+def bedroom():
+    """Bed against wall_0 between two nightstands, a lamp on the left one."""
+    r = Room([[0, 0], [5, 0], [5, 4], [0, 4]])
+    r.add("bed", "bed", (1.6, 2.0, 1.0), (2.5, 1.003))
+    r.add("ns_l", "nightstand", (0.5, 0.4, 0.55), (2.5 - 0.8 - 0.005 - 0.25, 0.203))
+    r.add("ns_r", "nightstand", (0.5, 0.4, 0.55), (2.5 + 0.8 + 0.004 + 0.25, 0.203))
+    r.add("lamp", "table_lamp", (0.25, 0.25, 0.45), (1.445, 0.203), z=0.551)
+    return r
+
+
+def test_lamp_on_nightstand_beside_bed():
+    g = bedroom().extract()
+    nodes = {n["node_id"]: n for n in g.nodes}
+    assert nodes["lamp"]["parent_id"] == "ns_l" and nodes["lamp"]["tier"] == 2
+    assert all(nodes[k]["parent_id"] is None and nodes[k]["tier"] == 1 for k in ("bed", "ns_l", "ns_r"))
+    sup = edge(g, "ns_l", "lamp", "support")
+    assert sup is not None and sup["support_area"] == pytest.approx(0.25 * 0.25, rel=0.01)
+    left, right = edge(g, "bed", "ns_l"), edge(g, "bed", "ns_r")
+    assert (left["direction"], left["distance"]) == ("left", "adjacent")
+    assert (right["direction"], right["distance"]) == ("right", "adjacent")
+    assert left["gap"] == pytest.approx(0.005, abs=1e-4)
+    back = edge(g, "ns_l", "bed")
+    assert (back["direction"], back["distance"]) == ("right", "adjacent")
+    wall = edge(g, "wall_0", "bed")
+    assert (wall["direction"], wall["distance"]) == ("front", "adjacent")
+    assert wall["gap"] == pytest.approx(0.003, abs=1e-4)
+    # first tier and second tier never relate spatially
+    assert edge(g, "bed", "lamp") is None and edge(g, "lamp", "bed") is None
+    # the far nightstand is hidden behind the bed from the near one
+    assert edge(g, "ns_l", "ns_r") is None
+    # the wall behind the bed sees the bed, not the nightstands' far sides only: every edge from a wall is front
+    assert {e["direction"] for e in g.edges if e["source"].startswith("wall") and e["edge_type"] == "spatial"} == {"front"}
+
+
+def test_python_backend_gives_the_same_graph():
+    r = bedroom()
+    with pytest.warns(RuntimeWarning, match="pure-Python"):
+        slow = r.extract(backend="python")
+    fast = r.extract()
+    key = lambda e: (e["source"], e["target"], e["edge_type"], e["direction"], e["distance"])
+    assert sorted(map(key, slow.edges)) == sorted(map(key, fast.edges))
+
+
+def test_chair_occluded_by_table():
+    r = Room([[0, 0], [6, 0], [6, 5], [0, 5]])
+    r.add("sofa", "sofa", (2.0, 0.9, 0.8), (3.0, 0.6))
+    r.add("table", "coffee_table", (1.6, 0.6, 0.45), (3.0, 1.8))
+    r.add("chair", "chair", (0.45, 0.5, 0.9), (3.0, 3.0))
+    g = r.extract()
+    assert edge(g, "sofa", "table")["direction"] == "front"
+    assert edge(g, "sofa", "chair") is None  # wholly behind the table
+    assert edge(g, "table", "chair")["direction"] == "front"
+    r.objects[2]["cx"] = r.objects[2]["px"] = 3.95  # 0.2 of its 0.45 m now clears the table: 44% visible
+    g = r.extract()
+    e = edge(g, "sofa", "chair")
+    assert e is not None and e["direction"] == "front" and e["distance"] == "distant"
+
+
+def test_partly_hidden_target_needs_30_percent():
+    r = Room([[0, 0], [6, 0], [6, 5], [0, 5]])
+    r.add("sofa", "sofa", (4.0, 0.9, 0.8), (3.0, 0.6))  # spans x 1..5
+    r.add("table", "coffee_table", (1.6, 0.6, 0.45), (3.0, 1.8))  # spans x 2.2..3.8
+    r.add("bench", "bench", (1.0, 0.5, 0.9), (3.55, 3.0))  # 0.25 of its 1.0 m sticks out past the table
+    g = r.extract()
+    assert edge(g, "sofa", "bench") is None
+    assert edge(g, "table", "bench") is not None
+    r.objects[2]["cx"] = r.objects[2]["px"] = 3.75  # 45% visible
+    e = edge(r.extract(), "sofa", "bench")
+    assert e is not None and e["target_visibility"] == pytest.approx(0.45, abs=0.01)
+
+
+def test_radial_anchor_labels_everything_front():
+    r = Room([[0, 0], [6, 0], [6, 6], [0, 6]])
+    v, f, (w, d, h) = catalog.build_model("round_table", 0, 0)
+    r.add("table", "round_table", (w, d, h), (3.0, 3.0), mesh=(v, f))
+    r.add("c_right", "chair", (0.45, 0.5, 0.9), (3.0 + w / 2 + 0.3, 3.0), yaw_deg=90)
+    r.add("c_back", "chair", (0.45, 0.5, 0.9), (3.0, 3.0 - d / 2 - 0.3))
+    g = r.extract(symmetry={"round_table": "radial"})
+    assert edge(g, "table", "c_right")["direction"] == "front"
+    assert edge(g, "table", "c_back")["direction"] == "front"
+    g = r.extract(symmetry={"round_table": "none"})
+    assert edge(g, "table", "c_right")["direction"] == "right"
+    assert edge(g, "table", "c_back")["direction"] == "back"
+
+
+def test_l_shaped_room_walls_and_reflex_corner():
+    r = Room([[0, 0], [4, 0], [4, 2], [2, 2], [2, 4], [0, 4]])
+    r.add("cab", "cabinet", (0.6, 0.5, 0.9), (3.0, 0.253))  # against wall_0, facing +y
+    r.add("plant", "plant", (0.4, 0.4, 1.0), (0.6, 3.5))  # in the upper arm of the L
+    r.door("door_0", (0.5, 4.0), (1.4, 4.0), "wall_4")
+    g = r.extract()
+    walls = [n for n in g.nodes if n["kind"] == "wall"]
+    assert len(walls) == 6
+    angles = sorted(round(math.degrees(e["angle"])) for e in g.edges if e["edge_type"] == "wall_adjacent" and e["direction"] == "right")
+    assert angles == [90, 90, 90, 90, 90, 270]
+    assert sum(e["edge_type"] == "wall_adjacent" for e in g.edges) == 12
+    opposite = {(e["source"], e["target"]) for e in g.edges if e["edge_type"] == "wall_opposite"}
+    assert ("wall_0", "wall_2") in opposite and ("wall_0", "wall_4") in opposite
+    assert edge(g, "wall_0", "cab")["distance"] == "adjacent"
+    # wall_1 (x = 4, facing -x, y in [0, 2]) has the plant outside its span
+    assert edge(g, "wall_1", "plant") is None
+    assert edge(g, "wall_0", "plant")["distance"] == "distant"
+    door = edge(g, "wall_4", "door_0", "opening")
+    assert door is not None and door["distance"] == "adjacent"
+
+
+def test_bad_objects_are_skipped_with_reasons():
+    r = bedroom()
+    r.add("flat", "rug", (1.0, 1.0, 0.0), (2.5, 3.0))
+    r.add("away", "chair", (0.5, 0.5, 0.9), (9.0, 9.0))
+    r.add("nomesh", "chair", (0.5, 0.5, 0.9), (4.0, 3.0))
+    r.models["m_nomesh"] = (np.zeros((0, 3)), np.zeros((0, 3), int))
+    r.add("nan", "chair", (0.5, 0.5, 0.9), (4.0, 2.0))
+    r.objects[-1]["cx"] = float("nan")
+    g = r.extract()
+    reasons = dict(g.skipped)
+    assert set(reasons) == {"flat", "away", "nomesh", "nan"}
+    assert "zero-size" in reasons["flat"] and "outside" in reasons["away"] and "mesh" in reasons["nomesh"]
+    assert edge(g, "bed", "ns_l") is not None  # the rest of the room is still extracted
+
+
+def test_open_wall_loop_is_a_clear_error():
+    r = bedroom()
+    walls = r.walls()
+    walls.loc[1, "y1"] = 3.5
+    from pipeline.extraction import extract_room
+    from pipeline.geometry.raycast import intersector_class
+
+    with pytest.raises(ValueError, match="closed loop"):
+        extract_room(r.row(), walls, r.openings_df(), r.objects_df(), r.models.get, lambda c, m: ("none", "table"),
+                     default_config()["extract"], intersector_class("embree"))
+
+
+def test_distance_labels_follow_the_paper():
+    # small objects: adjacent up to 5% of the diagonal; large: capped at 2 in
+    assert relations.distance_labels(0.02, 0.6, DIST) == "adjacent"
+    assert relations.distance_labels(0.04, 0.6, DIST) == "proximal"
+    assert relations.distance_labels(0.05, 3.0, DIST) == "adjacent"
+    assert relations.distance_labels(0.06, 3.0, DIST) == "proximal"
+    # proximal: 1.5 ft, or 10% of a large diagonal
+    assert relations.distance_labels(0.45, 1.0, DIST) == "proximal"
+    assert relations.distance_labels(0.46, 1.0, DIST) == "distant"
+    assert relations.distance_labels(0.55, 6.0, DIST) == "proximal"
+
+
+def test_support_cycles_are_broken_at_the_largest_object():
+    parent = np.array([1, 2, 0, -1])
+    size = np.array([1.0, 5.0, 2.0, 1.0])
+    fixed, cycles = relations.break_support_cycles(parent, size)
+    assert cycles == [[0, 1, 2]]
+    assert fixed.tolist() == [1, -1, 0, -1]
+    assert relations.tiers(fixed).tolist() == [2, 1, 3, 1]
+
+
+def test_overlapping_meshes_stack_on_the_larger_supporting_surface():
+    r = Room([[0, 0], [4, 0], [4, 4], [0, 4]])
+    r.add("desk", "desk", (1.2, 0.6, 0.75), (1.5, 1.0))
+    r.add("shelf", "shelf", (0.4, 0.6, 0.75), (2.3, 1.0))
+    r.add("box", "books", (0.4, 0.3, 0.1), (2.0, 1.0), z=0.752)  # 0.3 over the desk, 0.1 over the shelf
+    g = r.extract()
+    assert {n["node_id"]: n["parent_id"] for n in g.nodes}["box"] == "desk"

@@ -1,0 +1,77 @@
+import numpy as np
+from hypothesis import given, settings, strategies as st
+
+from pipeline.geometry.polygon import (extents, make_ccw, merge_collinear, outline_from_loop, polygon_segments,
+                                       signed_area, wall_loop)
+
+SQUARE = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], float)
+L_SHAPE = np.array([[0, 0], [4, 0], [4, 2], [2, 2], [2, 4], [0, 4]], float)
+
+
+def test_signed_area_and_orientation():
+    assert signed_area(SQUARE) == 4.0
+    assert signed_area(SQUARE[::-1]) == -4.0
+    assert signed_area(make_ccw(SQUARE[::-1])) == 4.0
+    assert signed_area(L_SHAPE) == 12.0
+    assert extents(L_SHAPE) == (4.0, 4.0)
+
+
+def test_merge_collinear_removes_midpoints_only():
+    with_mid = np.array([[0, 0], [1, 0], [2, 0], [2, 1], [2, 2], [0, 2]], float)
+    merged = merge_collinear(with_mid)
+    assert len(merged) == 4
+    assert set(map(tuple, merged)) == set(map(tuple, SQUARE))
+    assert len(merge_collinear(L_SHAPE)) == 6  # a reflex corner is no collinear point
+
+
+def test_wall_loop_closed_and_open():
+    segs = polygon_segments(L_SHAPE)
+    ok, why, order = wall_loop(segs)
+    assert ok and why == ""
+    assert np.isclose(abs(signed_area(outline_from_loop(segs, order))), 12.0)
+    gap = segs.copy()
+    gap[2, 1] += [0.0, -0.3]  # shorten one wall: the loop no longer closes
+    ok, why, _ = wall_loop(gap)
+    assert not ok and "meets no other wall" in why
+    assert not wall_loop(segs[:2])[0]
+
+
+def test_two_separate_loops_are_not_one_room():
+    a = polygon_segments(SQUARE)
+    b = polygon_segments(SQUARE + 10)
+    ok, why, _ = wall_loop(np.concatenate([a, b]))
+    assert not ok and "more than one loop" in why
+
+
+@st.composite
+def star_polygons(draw):
+    """Random simple polygons: sorted angles, random radii (star-shaped, so never self-intersecting)."""
+    n = draw(st.integers(3, 12))
+    angles = np.sort(np.array(draw(st.lists(st.floats(0, 2 * np.pi - 1e-3), min_size=n, max_size=n, unique=True))))
+    if np.min(np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]]))) < 1e-2:
+        angles = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    radii = np.array(draw(st.lists(st.floats(1.0, 5.0), min_size=n, max_size=n)))
+    return np.column_stack([radii * np.cos(angles), radii * np.sin(angles)])
+
+
+@settings(max_examples=200, deadline=None)
+@given(poly=star_polygons(), seed=st.integers(0, 2**31 - 1), cut=st.floats(0.01, 0.5))
+def test_wall_loop_properties(poly, seed, cut):
+    rng = np.random.default_rng(seed)
+    segs = polygon_segments(poly)
+    # shuffled and randomly reversed walls still form one closed loop with the same area
+    perm = rng.permutation(len(segs))
+    flips = rng.random(len(segs)) < 0.5
+    shuffled = np.array([s[::-1] if f else s for s, f in zip(segs[perm], flips)])
+    ok, _, order = wall_loop(shuffled)
+    assert ok
+    assert np.isclose(abs(signed_area(outline_from_loop(shuffled, order))), abs(signed_area(poly)))
+    assert signed_area(make_ccw(poly)) > 0
+    # pulling one endpoint away by more than the tolerance opens the loop
+    k = int(rng.integers(len(segs)))
+    broken = segs.copy()
+    d = broken[k, 1] - broken[k, 0]
+    broken[k, 1] -= d / np.linalg.norm(d) * min(cut, 0.5 * np.linalg.norm(d))
+    assert not wall_loop(broken, tol=1e-3)[0]
+    # dropping a wall opens it too
+    assert not wall_loop(np.delete(segs, k, axis=0))[0]
