@@ -1,8 +1,9 @@
 """Relation-graph extraction for one room (paper §4.3): support, spatial and architecture edges.
 
-A pure function of one room's canonical rows: no file IO. The ray casting runs in one Embree scene per room
-with two layers: the objects' world meshes (support rays) and, below the floor, vertical prisms over every
-object's and wall's floor footprint (the "plan" layer, where the paper's floor-plane visibility is swept).
+A pure function of one room's arrays (:class:`RoomInput`): no file IO. The ray casting runs in one Embree
+scene per room with two layers: the objects' world meshes (support rays) and, below the floor, vertical
+prisms over every object's and wall's floor footprint (the "plan" layer, where the paper's floor-plane
+visibility sweep runs). Support and spatial rays go to Embree in one batch.
 """
 from __future__ import annotations
 
@@ -14,16 +15,36 @@ import numpy as np
 import shapely
 
 from .geometry import meshes, relations
-from .geometry.boxes import SIDES, diagonal_2d
+from .geometry.boxes import SIDE_NORMALS, SIDES, diagonal_2d, rotation
 from .geometry.polygon import inward_normals, merge_collinear, outline_from_loop, signed_area, wall_loop
-from .geometry.raycast import RoomScene, first_accepted
+from .geometry.raycast import RoomScene
 
 log = logging.getLogger("planit.extract")
 
 PLAN_Z = (-3.0, -2.0)  # z band of the plan layer (below any floor-standing geometry)
 MESH, PLAN = 0, 1  # scene layers
 BOX_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
+POSE_COLUMNS = ["px", "py", "pz", "yaw", "sx", "sy", "sz"]
 PIECE_INSET = 1e-3  # m, rays start this far in from each piece's ends
+FLOOR_EPS = 1e-3  # m, an object whose bottom is this close to the floor (z = 0) stands on it
+
+
+@dataclass
+class RoomInput:
+    """One room as arrays: what extraction needs from the canonical tables."""
+    room_id: str
+    room_type: str
+    height: float
+    outline: np.ndarray  # (k, 2) floor outline
+    wall_ids: list[str]
+    wall_segments: np.ndarray  # (w, 2, 2) inner faces
+    wall_thickness: np.ndarray  # (w,)
+    openings: list[dict]  # element_id, kind, x0, y0, x1, y1, z0, z1
+    object_ids: list[str]
+    categories: list[str]
+    model_ids: list[str]
+    boxes: np.ndarray  # (n, 7) BOX_COLUMNS
+    poses: np.ndarray  # (n, 7) POSE_COLUMNS
 
 
 @dataclass
@@ -54,14 +75,13 @@ class Walls:
         return (self.b - self.a) / self.length[:, None]
 
 
-def merge_walls(arch_walls, height: float, tol: float = 1e-3) -> Walls:
+def merge_walls(segs: np.ndarray, ids: list[str], thick: np.ndarray, height: float, tol: float = 1e-3) -> Walls:
     """Order wall segments along their loop, make it counter-clockwise and merge collinear neighbours.
 
-    A merged wall keeps the id of the original wall at its start.
+    A merged wall keeps the id of the original wall at its start. Raises ValueError for an open loop.
     """
-    segs = arch_walls[["x0", "y0", "x1", "y1"]].to_numpy(float).reshape(-1, 2, 2)
-    ids = arch_walls["element_id"].astype(str).to_list()
-    thick = arch_walls["thickness"].astype(float).fillna(0.1).to_numpy(float)
+    segs = np.asarray(segs, float).reshape(-1, 2, 2)
+    thick = np.where(np.isfinite(thick), thick, 0.1)
     closed, why, order = wall_loop(segs, tol)
     if not closed:
         raise ValueError(f"walls do not form a closed loop: {why}")
@@ -83,75 +103,94 @@ def wall_footprints(w: Walls) -> np.ndarray:
     return np.stack([w.a, w.b, w.b + back, w.a + back], 1)[:, ::-1]
 
 
-def extract_room(room, walls_df, openings_df, objects_df, mesh_of, symmetry_of, cfg: dict, intersector) -> RoomGraph:
+def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) -> RoomGraph:
     """Raw relation graph of one room.
 
     ``mesh_of(model_id) -> (vertices, faces) | None`` in model space; ``symmetry_of(category, model_id) ->
     (symmetry, origin)``; ``cfg`` is the ``extract`` config section; ``intersector`` a trimesh ray class.
     """
     g = RoomGraph()
-    walls = merge_walls(walls_df, float(room.height))
-    objs, parts = _usable_objects(g, room, objects_df, mesh_of)
-    n, n_walls = len(objs), len(walls.ids)
-    ids = objs["object_id"].astype(str).to_numpy()
-    b = objs[BOX_COLUMNS].to_numpy(float).reshape(-1, 7)
+    walls = merge_walls(room.wall_segments, room.wall_ids, room.wall_thickness, room.height)
+    keep, parts = _usable_objects(g, room, mesh_of)
+    ids = [room.object_ids[k] for k in keep]
+    cats = [room.categories[k] for k in keep]
+    models = [room.model_ids[k] for k in keep]
+    b = room.boxes[keep].reshape(-1, 7)
+    n, n_walls = len(ids), len(walls.ids)
     obj_fp, wall_fp = relations.footprints(b), wall_footprints(walls)
-    # one scene: object meshes (layer MESH) + plan prisms of objects and walls (layer PLAN)
-    prism_parts = [meshes.prisms(fp[None], *PLAN_Z) for fp in np.concatenate([obj_fp, wall_fp])]
-    scene = RoomScene(parts + prism_parts, list(range(n)) + list(range(n + n_walls)),
-                      [MESH] * n + [PLAN] * (n + n_walls), intersector)
+    all_fp = np.concatenate([obj_fp, wall_fp])
+    plan = meshes.prisms(all_fp, *PLAN_Z)
+    per_prism = meshes.faces_per_prism(4)
+    scene = RoomScene(parts + [plan], list(range(n)) + [0], [MESH] * n + [PLAN], intersector)
+    scene.owner[-len(plan[1]):] = np.repeat(np.arange(n + n_walls), per_prism)  # one owner per prism
 
-    parent, area = np.full(n, -1), np.zeros(n)
+    # rays: support grid under every object, then the visibility sweep of every anchor side
+    sc = cfg["support"]
+    raised = np.flatnonzero(b[:, 2] - b[:, 5] > FLOOR_EPS)  # nothing lies under the floor: only raised objects cast
+    s_orig, s_dir, s_obj, cell = relations.support_rays(b[raised], sc["grid"], sc["start_offset"])
+    s_obj = raised[s_obj]
+    cell = np.zeros(n) if not len(raised) else np.bincount(raised, weights=cell, minlength=n)
+    sym = [symmetry_of(c, m) for c, m in zip(cats, models)]
     volume = np.prod(2 * b[:, 3:6], axis=1)
-    if n:
-        sc = cfg["support"]
-        origins, dirs, obj, cell = relations.support_rays(b, sc["grid"], sc["start_offset"])
-        ray, own, lay, dist = scene.hits(origins, dirs)
-        g.rays += len(origins)
-        first_owner, first_dist = first_accepted(ray, own, dist, (lay == MESH) & (own != obj[ray]), len(origins))
-        parent, area = relations.choose_parents(obj, first_owner, first_dist, cell, sc["start_offset"] + sc["max_distance"], volume)
-        parent, cycles = relations.break_support_cycles(parent, volume)
-        area[parent < 0] = 0.0
-        g.support_cycles = len(cycles)
+    # support first (the sweep's groups depend on tiers): nearest mesh of another object below each grid point
+    reach = sc["start_offset"] + sc["max_distance"]
+    first_owner, first_dist = scene.first_accepted(
+        s_orig, s_dir, lambda r, own, lay: (lay == MESH) & (own != s_obj[r]), max_dist=reach)
+    parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, volume)
+    parent, cycles = relations.break_support_cycles(parent, volume)
+    area[parent < 0] = 0.0
+    g.support_cycles = len(cycles)
     tier = relations.tiers(parent)
-    sym = [symmetry_of(c, m) for c, m in zip(objs["category"].astype(str), objs["model_id"].astype(str))]
+    g.rays += len(s_orig)
 
-    for k, o in enumerate(objs.itertuples(index=False)):
-        g.nodes.append({"room_id": room.room_id, "node_id": ids[k], "kind": "object", "category": str(o.category),
-                        "model_id": o.model_id, "symmetry": sym[k][0], "symmetry_origin": sym[k][1], "tier": int(tier[k]),
+    for k in range(n):
+        g.nodes.append({"room_id": room.room_id, "node_id": ids[k], "kind": "object", "category": cats[k],
+                        "model_id": models[k], "symmetry": sym[k][0], "symmetry_origin": sym[k][1], "tier": int(tier[k]),
                         "parent_id": ids[parent[k]] if parent[k] >= 0 else None,
-                        **{c: float(b[k, i]) for i, c in enumerate(BOX_COLUMNS)}, "length": None})
+                        **dict(zip(BOX_COLUMNS, map(float, b[k]))), "length": None})
         if parent[k] >= 0:
             g.edges.append(_edge(room.room_id, ids[parent[k]], ids[k], "support", support_area=float(area[k])))
     _wall_nodes(g, room.room_id, walls)
     radial = np.array([s[0] == "radial" for s in sym], bool)
-    g.rays += _spatial_edges(g, room.room_id, scene, b, obj_fp, ids, parent, tier, radial, walls, wall_fp, cfg)
-    _architecture_edges(g, room.room_id, walls, openings_df)
+    group = np.concatenate([np.where(tier <= 1, 0, parent + 1), np.zeros(n_walls, int)])  # who sees whom
+    g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
+    _architecture_edges(g, room.room_id, walls, room.openings)
     return g
 
 
-def _usable_objects(g: RoomGraph, room, objects_df, mesh_of):
-    """Objects with a finite, non-degenerate box and mesh, centred inside the room; the rest are skipped with a reason."""
-    objs = objects_df.reset_index(drop=True)
-    outline = shapely.Polygon(np.column_stack([room.floor_x, room.floor_y])).buffer(0.05)
-    keep, parts = [], []
-    for k, o in enumerate(objs.itertuples(index=False)):
-        box = np.array([getattr(o, c) for c in BOX_COLUMNS], float)
-        if not np.all(np.isfinite(box)) or min(o.hx, o.hy, o.hz) <= 1e-4:
-            g.skipped.append((o.object_id, "zero-size or non-finite box"))
+def _usable_objects(g: RoomGraph, room: RoomInput, mesh_of) -> tuple[list[int], list]:
+    """Indices and world meshes of objects with a finite, non-degenerate box and mesh, centred inside the room;
+    the rest are skipped with a reason."""
+    outline = shapely.Polygon(room.outline).buffer(0.05)
+    inside = shapely.contains_xy(outline, room.boxes[:, 0], room.boxes[:, 1]) if len(room.boxes) else np.zeros(0, bool)
+    finite = np.isfinite(room.boxes).all(axis=1) & np.isfinite(room.poses).all(axis=1)
+    sized = room.boxes[:, 3:6].min(axis=1) > 1e-4 if len(room.boxes) else np.zeros(0, bool)
+    keep, local = [], []
+    for k, oid in enumerate(room.object_ids):
+        if not (finite[k] and sized[k]):
+            g.skipped.append((oid, "zero-size or non-finite box"))
             continue
-        if not shapely.contains_xy(outline, o.cx, o.cy):
-            g.skipped.append((o.object_id, "centre outside the room outline"))
+        if not inside[k]:
+            g.skipped.append((oid, "centre outside the room outline"))
             continue
-        mesh = mesh_of(o.model_id)
-        if mesh is None or len(mesh[1]) == 0 or not np.all(np.isfinite(mesh[0])):
-            g.skipped.append((o.object_id, f"model {o.model_id}: missing or degenerate mesh"))
+        mesh = mesh_of(room.model_ids[k])
+        if mesh is None or len(mesh[1]) == 0 or not np.isfinite(mesh[0]).all():
+            g.skipped.append((oid, f"model {room.model_ids[k]}: missing or degenerate mesh"))
             continue
-        v = meshes.transform(mesh[0], (o.px, o.py, o.pz), o.yaw, (o.sx, o.sy, o.sz))
-        f = mesh[1][:, ::-1] if (o.sx * o.sy * o.sz) < 0 else mesh[1]
         keep.append(k)
-        parts.append((v, f))
-    return objs.iloc[keep].reset_index(drop=True), parts
+        local.append(mesh)
+    if not keep:
+        return keep, []
+    # all model -> world transforms in one pass
+    counts = np.array([len(v) for v, _ in local])
+    pose = np.repeat(room.poses[keep], counts, axis=0)
+    v = np.concatenate([v for v, _ in local]) * pose[:, 4:7]
+    c, s = np.cos(pose[:, 3]), np.sin(pose[:, 3])
+    world = np.column_stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1], v[:, 2]]) + pose[:, 0:3]
+    parts = []
+    for (_, f), vw, p in zip(local, np.split(world, np.cumsum(counts)[:-1]), room.poses[keep]):
+        parts.append((vw, f[:, ::-1] if np.prod(p[4:7]) < 0 else f))  # mirrored: keep faces outward
+    return keep, parts
 
 
 def _wall_nodes(g: RoomGraph, room_id: str, walls: Walls) -> None:
@@ -168,94 +207,113 @@ def _yaw_facing(normal) -> float:
     return math.atan2(normal[1], normal[0]) - math.pi / 2
 
 
-def _spatial_edges(g, room_id, scene, b, obj_fp, ids, parent, tier, radial, walls, wall_fp, cfg) -> int:
-    """Sweep every anchor side (4 per object, the inner face per wall) and add the visible spatial edges."""
+def anchor_sides(b: np.ndarray, walls: Walls, sp: dict) -> dict[str, np.ndarray]:
+    """Every anchor side as arrays: 4 per object (front, back, left, right), the inner face per wall."""
+    n = len(b)
+    r = rotation(b[:, 6])  # (n, 2, 2)
+    normal = np.einsum("nij,sj->nsi", r, SIDE_NORMALS).reshape(-1, 2)
+    tangent = np.stack([normal[:, 1], -normal[:, 0]], 1)  # to the right when looking out of the side
+    along_y = np.tile(SIDE_NORMALS[:, 1] != 0, n)
+    hx, hy = np.repeat(b[:, 3], 4), np.repeat(b[:, 4], 4)
+    half_depth = np.where(along_y, hy, hx)
+    half_len = np.where(along_y, hx, hy)
+    centre = np.repeat(b[:, :2], 4, axis=0) + normal * half_depth[:, None]
+    inset = np.minimum(sp["inset_fraction"] * 2 * half_depth, sp["inset_max"])
+    w = len(walls.ids)
+    return {
+        "owner": np.concatenate([np.repeat(np.arange(n), 4), n + np.arange(w)]),
+        "side": np.concatenate([np.tile(np.arange(4), n), np.zeros(w, int)]),
+        "centre": np.concatenate([centre, (walls.a + walls.b) / 2]),
+        "tangent": np.concatenate([tangent, walls.dir]),
+        "normal": np.concatenate([normal, walls.normal]),
+        "half": np.concatenate([half_len, walls.length / 2]),
+        "inset": np.concatenate([inset, np.minimum(sp["inset_fraction"] * walls.thickness, sp["inset_max"])]),
+    }
+
+
+def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Split every side at the projected endpoints of the footprints it may see (same group, not itself,
+    not wholly behind its ray origins). Returns ``piece_side (p,)``, ``starts (p,)``, ``ends (p,)``."""
+    owners = sides["owner"]
+    o = len(all_fp)
+    rel = all_fp[None, :, :, :] - sides["centre"][:, None, None, :]  # (S, O, 4, 2)
+    t = np.einsum("sokj,sj->sok", rel, sides["tangent"])
+    d = np.einsum("sokj,sj->sok", rel, sides["normal"])
+    lo, hi = t.min(axis=2), t.max(axis=2)
+    half = sides["half"][:, None]
+    live = ((group[None, :] == group[owners][:, None]) & (np.arange(o)[None, :] != owners[:, None])
+            & (d.max(axis=2) > -sides["inset"][:, None]) & (hi > -half) & (lo < half))
+    cuts = np.concatenate([-half, half, np.where(live, np.clip(lo, -half, half), np.nan),
+                           np.where(live, np.clip(hi, -half, half), np.nan)], axis=1)
+    cuts = np.sort(cuts, axis=1)  # NaN sort last
+    starts, ends = cuts[:, :-1], cuts[:, 1:]
+    valid = np.isfinite(ends) & (ends - starts > 1e-6)
+    side_idx = np.broadcast_to(np.arange(len(owners))[:, None], starts.shape)
+    return side_idx[valid], starts[valid], ends[valid]
+
+
+def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg) -> int:
+    """Sweep every anchor side and add the visible spatial edges. Returns the number of rays cast."""
     n, n_walls = len(b), len(walls.ids)
+    total = n + n_walls
     sp = cfg["spatial"]
-    group = np.concatenate([np.where(tier <= 1, 0, parent + 1), np.zeros(n_walls, int)])  # who sees whom
-    all_fp = np.concatenate([obj_fp, wall_fp])
-    diag = diagonal_2d(b[:, 3], b[:, 4])
-    sides = []  # (anchor owner, side index, centre, tangent, normal, half_len, inset)
-    for k in range(n):
-        for s, (_, c, t, nrm, half, depth) in enumerate(relations.box_sides(b[k])):
-            sides.append((k, s, c, t, nrm, half, min(sp["inset_fraction"] * depth, sp["inset_max"])))
-    for w in range(n_walls):
-        c = (walls.a[w] + walls.b[w]) / 2
-        sides.append((n + w, 0, c, walls.dir[w], walls.normal[w], walls.length[w] / 2,
-                      min(sp["inset_fraction"] * walls.thickness[w], sp["inset_max"])))
-    origins, ray_piece, piece_side, piece_len, offset = [], [], [], [], 0
-    for si, (owner, _, c, t, nrm, half, inset) in enumerate(sides):
-        others = np.flatnonzero((group == group[owner]) & (np.arange(n + n_walls) != owner))
-        starts, ends, _ = relations.sweep_pieces(c, t, nrm, half, all_fp[others], inset)
-        pos, piece = relations.piece_rays(starts, ends, PIECE_INSET)
-        xy = c + pos[:, None] * t - nrm * inset
-        origins.append(np.column_stack([xy, np.full(len(pos), sum(PLAN_Z) / 2)]))
-        ray_piece.append(piece + offset)
-        offset += len(starts)
-        piece_side.append(np.full(len(starts), si))
-        piece_len.append(ends - starts)
-    piece_side = np.concatenate(piece_side)
-    piece_len = np.concatenate(piece_len)
-    ray_piece = np.concatenate(ray_piece)
-    origins = np.concatenate(origins)
-    side_owner = np.array([s[0] for s in sides])
-    side_normal = np.array([s[4] for s in sides])
-    side_inset = np.array([s[6] for s in sides])
+    sides = anchor_sides(b, walls, sp)
+    piece_side, starts, ends = sweep(sides, all_fp, group)
+    pos, ray_piece = relations.piece_rays(starts, ends, PIECE_INSET)
     ray_side = piece_side[ray_piece]
-    dirs = np.column_stack([side_normal[ray_side], np.zeros(len(origins))])
-    ray, own, lay, dist = scene.hits(origins, dirs)
-    anchor_of_ray = side_owner[ray_side]
-    accept = (lay == PLAN) & (own != anchor_of_ray[ray]) & (group[own] == group[anchor_of_ray[ray]])
-    hit_owner, hit_dist = first_accepted(ray, own, dist, accept, len(origins))
-    # per piece: the nearer of its two rays
-    pr = hit_dist.reshape(-1, 2)
+    xy = sides["centre"][ray_side] + pos[:, None] * sides["tangent"][ray_side] - sides["normal"][ray_side] * sides["inset"][ray_side, None]
+    origins = np.column_stack([xy, np.full(len(pos), sum(PLAN_Z) / 2)])
+    dirs = np.column_stack([sides["normal"][ray_side], np.zeros(len(pos))])
+    anchor = sides["owner"][ray_side]
+    # supported anchors only see siblings on the same parent: their rays stop beyond the parent's footprint
+    diag = np.concatenate([diagonal_2d(b[:, 3], b[:, 4]), np.zeros(n_walls)])  # walls: the target's diagonal decides
+    reach_of_group = np.concatenate([[np.inf], 2 * diag[:n]])  # group g > 0 lives on object g - 1
+    reach = sides["inset"][ray_side] + reach_of_group[group[anchor]]
+    hit_owner, hit_dist = scene.first_accepted(
+        origins, dirs, lambda r, own, lay: (lay == PLAN) & (own != anchor[r]) & (group[own] == group[anchor[r]]),
+        max_dist=reach)
+    pr = hit_dist.reshape(-1, 2)  # per piece: the nearer of its two rays
     pick = np.argmin(pr, axis=1)
     p_owner = hit_owner.reshape(-1, 2)[np.arange(len(pr)), pick]
     p_dist = pr[np.arange(len(pr)), pick]
     ok = (p_owner >= 0) & (p_owner < n)  # pieces that reach an object (walls only occlude)
-    if not ok.any():
+    contained = _contained_pairs(all_fp[:n], group[:n], sp["contain_fraction"])
+    if not ok.any() and not contained:
         return len(origins)
-    ps, po = piece_side[ok], p_owner[ok]
-    key = ps * (n + n_walls) + po
+    key = piece_side[ok] * total + p_owner[ok]
     uniq, inv = np.unique(key, return_inverse=True)
-    vis = np.bincount(inv, weights=piece_len[ok])
+    vis = np.bincount(inv, weights=(ends - starts)[ok], minlength=len(uniq))
     gap = np.full(len(uniq), np.inf)
     np.minimum.at(gap, inv, p_dist[ok])
-    u_side, u_target = uniq // (n + n_walls), uniq % (n + n_walls)
-    gap -= side_inset[u_side]
-    tangents = np.array([s[3] for s in sides])[u_side]
-    proj = np.einsum("mkj,mj->mk", obj_fp[u_target], tangents)
+    u_side, u_target = uniq // total, uniq % total
+    gap -= sides["inset"][u_side]
+    proj = np.einsum("mkj,mj->mk", all_fp[u_target], sides["tangent"][u_side])
     target_share = np.minimum(vis / np.maximum(np.ptp(proj, axis=1), 1e-9), 1.0)
-    anchor_share = vis / (2 * np.array([s[5] for s in sides])[u_side])
+    anchor_share = np.minimum(vis / (2 * sides["half"][u_side]), 1.0)
     score = np.maximum(target_share, anchor_share)
-    u_anchor = side_owner[u_side]
-    u_sidx = np.array([s[1] for s in sides])[u_side]
-    scores = {}  # (anchor, target) -> per-side scores
-    for a, t, s, sc in zip(u_anchor, u_target, u_sidx, score):
-        scores.setdefault((int(a), int(t)), np.zeros(4))[s] = sc
-    keep = score >= sp["min_visibility"]
-    best: dict[tuple[int, int], int] = {}
-    for i in np.flatnonzero(keep):
-        pair = (int(u_anchor[i]), int(u_target[i]))
-        j = best.get(pair)
-        if j is None or (score[i], -gap[i]) > (score[j], -gap[j]):
-            best[pair] = i
-    contained = _contained_pairs(obj_fp, group[:n], sp["contain_fraction"])
-    for pair in contained:
-        if pair not in best:
-            best[pair] = -1
-    for (a, t), i in sorted(best.items()):
+    u_anchor, u_sidx = sides["owner"][u_side], sides["side"][u_side]
+    side_scores = np.zeros((total, total, 4))
+    side_scores[u_anchor, u_target, u_sidx] = score
+    # best qualifying side per (anchor, target): highest visibility, then smallest gap
+    cand = np.flatnonzero(score >= sp["min_visibility"])
+    cand = cand[np.lexsort((gap[cand], -score[cand], u_target[cand], u_anchor[cand]))]
+    pairs = u_anchor[cand] * total + u_target[cand]
+    unique_pairs, first = np.unique(pairs, return_index=True)
+    best = dict(zip(unique_pairs.tolist(), cand[first].tolist()))
+    for a, t in contained:
+        best.setdefault(a * total + t, -1)
+    u_label = relations.distance_labels(gap, np.maximum(diag[u_anchor], diag[u_target]), cfg["distance"])
+    for pair in sorted(best):
+        a, t = divmod(pair, total)
+        i = best[pair]
         is_wall = a >= n
-        max_diag = diag[t] if is_wall else max(diag[a], diag[t])
-        if i < 0:  # target mostly inside the anchor's footprint
+        if i < 0:  # target mostly inside the anchor's footprint, seen by no ray
             direction, gap_i, tv, av, label = "front", 0.0, 1.0, 1.0, "adjacent"
         else:
             direction = "front" if is_wall or radial[a] else SIDES[u_sidx[i]]
             gap_i, tv, av = float(gap[i]), float(target_share[i]), float(anchor_share[i])
-            label = str(relations.distance_labels(gap_i, max_diag, cfg["distance"]))
-            if (a, t) in contained:
-                label = "adjacent"
-        sc = scores.get((a, t), np.zeros(4))
+            label = "adjacent" if (a, t) in contained else str(u_label[i])
+        sc = side_scores[a, t]
         src = walls.ids[a - n] if is_wall else ids[a]
         g.edges.append(_edge(room_id, src, ids[t], "spatial", direction, label, gap=gap_i, target_visibility=tv,
                              anchor_visibility=av, score_front=float(sc[0]), score_back=float(sc[1]),
@@ -268,15 +326,19 @@ def _contained_pairs(fp: np.ndarray, group: np.ndarray, fraction: float) -> set[
     n = len(fp)
     if n < 2:
         return set()
+    lo, hi = fp.min(axis=1), fp.max(axis=1)
+    touch = np.all((lo[:, None] < hi[None, :]) & (lo[None, :] < hi[:, None]), axis=2)
+    i, j = np.nonzero(touch & (group[:, None] == group[None, :]) & ~np.eye(n, dtype=bool))
+    if not len(i):
+        return set()
     polys = shapely.polygons(fp)
-    i, j = np.nonzero((group[:, None] == group[None, :]) & ~np.eye(n, dtype=bool))
     inter = shapely.area(shapely.intersection(polys[i], polys[j]))
     frac = inter / np.maximum(shapely.area(polys[j]), 1e-12)
     sel = frac >= fraction
     return set(zip(i[sel].tolist(), j[sel].tolist()))
 
 
-def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings_df) -> None:
+def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings: list[dict]) -> None:
     """Wall loop (adjacent, with the corner angle), walls facing each other, doors and windows on their wall."""
     w = len(walls.ids)
     d = walls.dir
@@ -295,26 +357,23 @@ def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings_df) -
             overlap = min(t[1], walls.length[i]) - max(t[0], 0.0)
             if dist > 0 and overlap >= 0.3 * min(walls.length[i], walls.length[j]):
                 g.edges.append(_edge(room_id, walls.ids[i], walls.ids[j], "wall_opposite", "front", "distant", gap=dist))
-    for o in openings_df.itertuples(index=False):
-        mid = np.array([(o.x0 + o.x1) / 2, (o.y0 + o.y1) / 2])
+    for o in openings:
+        mid = np.array([(o["x0"] + o["x1"]) / 2, (o["y0"] + o["y1"]) / 2])
         rel = mid - walls.a
         t = np.einsum("ij,ij->i", rel, d)
         off = np.abs(np.einsum("ij,ij->i", rel, walls.normal))
         on = (t >= -1e-3) & (t <= walls.length + 1e-3)
-        if not on.any():
-            g.skipped.append((o.element_id, "opening is on no wall"))
+        if not on.any() or off[on].min() > 0.05:
+            g.skipped.append((o["element_id"], "opening lies on no wall of the room"))
             continue
         wi = int(np.flatnonzero(on)[np.argmin(off[on])])
-        if off[wi] > 0.05:
-            g.skipped.append((o.element_id, f"opening lies {off[wi]:.2f} m off its nearest wall"))
-            continue
-        width = float(math.hypot(o.x1 - o.x0, o.y1 - o.y0))
-        g.nodes.append({"room_id": room_id, "node_id": o.element_id, "kind": str(o.kind), "category": str(o.kind),
+        width = float(math.hypot(o["x1"] - o["x0"], o["y1"] - o["y0"]))
+        g.nodes.append({"room_id": room_id, "node_id": o["element_id"], "kind": o["kind"], "category": o["kind"],
                         "model_id": None, "symmetry": "none", "symmetry_origin": "architecture", "tier": 0, "parent_id": None,
-                        "cx": float(mid[0]), "cy": float(mid[1]), "cz": float((o.z0 + o.z1) / 2), "hx": width / 2,
-                        "hy": float(walls.thickness[wi] / 2), "hz": float((o.z1 - o.z0) / 2),
+                        "cx": float(mid[0]), "cy": float(mid[1]), "cz": float((o["z0"] + o["z1"]) / 2), "hx": width / 2,
+                        "hy": float(walls.thickness[wi] / 2), "hz": float((o["z1"] - o["z0"]) / 2),
                         "yaw": _yaw_facing(walls.normal[wi]), "length": width})
-        g.edges.append(_edge(room_id, walls.ids[wi], o.element_id, "opening", "front", "adjacent", gap=0.0))
+        g.edges.append(_edge(room_id, walls.ids[wi], o["element_id"], "opening", "front", "adjacent", gap=0.0))
 
 
 def _edge(room_id, src, dst, edge_type, direction=None, distance=None, **extra) -> dict:

@@ -14,6 +14,7 @@ from pipeline.extraction import extract_room
 from pipeline.geometry import meshes
 from pipeline.geometry.polygon import polygon_segments
 from pipeline.geometry.raycast import intersector_class
+from pipeline.roomdata import room_inputs
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = ROOT.parent / "shared" / "data"
@@ -68,11 +69,16 @@ class Room:
         cols = ["room_id", "element_id", "kind", "x0", "y0", "x1", "y1", "z0", "z1", "thickness", "wall_id"]
         return pd.DataFrame(self.openings, columns=cols)
 
-    def extract(self, backend="embree", symmetry=None, cfg=None):
+    def room_input(self, walls=None):
+        rooms = pd.DataFrame([vars(self.row())])
+        arch = pd.concat([walls if walls is not None else self.walls(), self.openings_df()], ignore_index=True)
+        return next(room_inputs(rooms, arch, self.objects_df()))
+
+    def extract(self, backend="embree", symmetry=None, cfg=None, walls=None):
         cfg = cfg or default_config()["extract"]
         symmetry = symmetry or {}
-        return extract_room(self.row(), self.walls(), self.openings_df(), self.objects_df(), self.models.get,
-                            lambda c, m: (symmetry.get(c, "none"), "table"), cfg, intersector_class(backend))
+        return extract_room(self.room_input(walls), self.models.get, lambda c, m: (symmetry.get(c, "none"), "table"),
+                            cfg, intersector_class(backend))
 
 
 def default_config() -> dict:

@@ -136,12 +136,8 @@ def test_open_wall_loop_is_a_clear_error():
     r = bedroom()
     walls = r.walls()
     walls.loc[1, "y1"] = 3.5
-    from pipeline.extraction import extract_room
-    from pipeline.geometry.raycast import intersector_class
-
     with pytest.raises(ValueError, match="closed loop"):
-        extract_room(r.row(), walls, r.openings_df(), r.objects_df(), r.models.get, lambda c, m: ("none", "table"),
-                     default_config()["extract"], intersector_class("embree"))
+        r.extract(walls=walls)
 
 
 def test_distance_labels_follow_the_paper():

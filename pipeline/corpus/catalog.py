@@ -23,8 +23,8 @@ def table(w, d, h, rng, round_top=False):
     t = 0.03 + 0.02 * rng.random()
     if round_top:
         r = w / 2
-        return [M.cylinder(r, t, (0, 0, h - t / 2), 24), M.cylinder(0.05, h - t, (0, 0, (h - t) / 2), 12),
-                M.cylinder(r * 0.5, 0.02, (0, 0, 0.01), 24)]
+        return [M.cylinder(r, t, (0, 0, h - t / 2), 16), M.cylinder(0.05, h - t, (0, 0, (h - t) / 2), 12),
+                M.cylinder(r * 0.5, 0.02, (0, 0, 0.01), 16)]
     return [M.box((w, d, t), (0, 0, h - t / 2)), *_legs(w, d, h - t, 0.025, 0.06)]
 
 
@@ -55,8 +55,8 @@ def seat(w, d, h, rng, back=True, arms=False, seat_h=0.45, soft=False):
 
 
 def stool(w, d, h, rng):
-    return [M.cylinder(w / 2, 0.04, (0, 0, h - 0.02), 16), M.cylinder(0.03, h - 0.04, (0, 0, (h - 0.04) / 2), 8),
-            M.cylinder(w / 2 * 0.8, 0.02, (0, 0, 0.01), 16)]
+    return [M.cylinder(w / 2, 0.04, (0, 0, h - 0.02)), M.cylinder(0.03, h - 0.04, (0, 0, (h - 0.04) / 2), 8),
+            M.cylinder(w / 2 * 0.8, 0.02, (0, 0, 0.01))]
 
 
 def bed(w, d, h, rng):
@@ -80,17 +80,17 @@ def screen(w, d, h, rng, stand=True):
 
 def lamp(w, d, h, rng):
     r = w / 2
-    return [M.cylinder(r * 0.5, 0.03, (0, 0, 0.015), 16), M.cylinder(0.012, h * 0.7, (0, 0, 0.03 + h * 0.35), 8),
-            M.cone(r, h * 0.3, (0, 0, h * 0.7), 16)]
+    return [M.cylinder(r * 0.5, 0.03, (0, 0, 0.015)), M.cylinder(0.012, h * 0.7, (0, 0, 0.03 + h * 0.35), 8),
+            M.cone(r, h * 0.3, (0, 0, h * 0.7))]
 
 
 def plant(w, d, h, rng):
     pot_h = h * 0.35
-    return [M.cylinder(w * 0.3, pot_h, (0, 0, pot_h / 2), 16), M.sphere(w / 2, (0, 0, h - w / 2), 1)]
+    return [M.cylinder(w * 0.3, pot_h, (0, 0, pot_h / 2)), M.sphere(w / 2, (0, 0, h - w / 2), 1)]
 
 
 def vessel(w, d, h, rng):
-    return [M.cylinder(w / 2, h, (0, 0, h / 2), 16), M.cylinder(w / 2 * 0.8, 0.01, (0, 0, h + 0.005), 16)]
+    return [M.cylinder(w / 2, h, (0, 0, h / 2)), M.cylinder(w / 2 * 0.8, 0.01, (0, 0, h + 0.005))]
 
 
 def appliance(w, d, h, rng):
@@ -123,7 +123,7 @@ def desk(w, d, h, rng):
 
 
 def toilet(w, d, h, rng):
-    return [M.cylinder(w / 2, 0.4, (0, d * 0.15, 0.2), 16), M.box((w, d * 0.3, h), (0, -d / 2 + d * 0.15, h / 2))]
+    return [M.cylinder(w / 2, 0.4, (0, d * 0.15, 0.2)), M.box((w, d * 0.3, h), (0, -d / 2 + d * 0.15, h / 2))]
 
 
 def bathtub(w, d, h, rng):
@@ -148,7 +148,7 @@ def laptop(w, d, h, rng):
 
 
 def bowl(w, d, h, rng):
-    return [M.cylinder(w / 2 * 0.6, h * 0.4, (0, 0, h * 0.2), 16), M.cone(w / 2, h * 0.6, (0, 0, h * 0.4), 16)]
+    return [M.cylinder(w / 2 * 0.6, h * 0.4, (0, 0, h * 0.2)), M.cone(w / 2, h * 0.6, (0, 0, h * 0.4))]
 
 
 TEMPLATES = {
@@ -251,6 +251,10 @@ CATEGORIES: dict[str, Category] = {c.name: c for c in [
     _c("bathtub", "bathtub", (0.7, 0.8), (1.6, 1.75), (0.55, 0.6), "left-right"),
     _c("shower", "block", (0.85, 0.95), (0.85, 0.95), (2.0, 2.1), "rotational-4", square=True),
     _c("hamper", "block", (0.4, 0.5), (0.35, 0.4), (0.55, 0.65), "rotational-2"),
+    _c("toilet_brush", "vessel", (0.1, 0.13), (0.1, 0.13), (0.35, 0.42), "radial", square=True),
+    _c("bath_scale", "block", (0.3, 0.34), (0.3, 0.34), (0.03, 0.05), "rotational-4", square=True),
+    _c("candle", "vessel", (0.06, 0.09), (0.06, 0.09), (0.1, 0.2), "radial", square=True),
+    _c("mirror", "screen", (0.5, 0.7), (0.3, 0.4), (1.5, 1.8), "left-right"),
 ]}
 
 # Rare categories: each used by a handful of "rare category" defect rooms only.

@@ -118,6 +118,7 @@ class RoomBuilder:
     objects: list[Obj] = field(default_factory=list)
     gt: list[dict] = field(default_factory=list)
     keepout: list = field(default_factory=list)
+    index: int = 0
     _groups: int = 0
 
     # ------------------------------------------------------------------ architecture
@@ -515,14 +516,22 @@ def _bathroom(r: RoomBuilder) -> None:
         r.in_corner("bathtub")
     else:
         r.in_corner("shower")
-    r.against_wall("vanity", on_top=str(r.rng.choice(["soap", "cup", "small_plant"])))
+    r.against_wall("vanity", on_top=str(r.rng.choice(["soap", "cup", "small_plant", "candle"])))
     if r.rng.random() < 0.4:
-        pair = r.wall_group([("washing_machine", r.model("washing_machine"), 0.0, 0.3, 0.0)])
-        if pair is not None:
-            wall, (wm,) = pair
-            r.wall_adjacent(wall, [wm])
-    r.clutter(["trash_can", "towel_rack", "laundry_basket", "hamper", "plant", "stool", "radiator", "shelf"],
-              int(r.rng.integers(1, 4)))
+        laundry = ["washing_machine", "dryer"] if r.rng.random() < 0.6 else ["washing_machine"]
+        pieces, x = [], 0.0
+        for cat in laundry:
+            m = r.model(cat)
+            pieces.append((cat, m, x + m.w / 2, r.gap(0.006) + m.d / 2, 0.0))
+            x += m.w + r.gap()
+        placed = r.wall_group(pieces)
+        if placed is not None:
+            wall, objs = placed
+            r.wall_adjacent(wall, objs)
+            if len(objs) == 2:
+                r.adjacent(objs[0], objs[1])
+    r.clutter(["trash_can", "towel_rack", "laundry_basket", "hamper", "plant", "stool", "radiator", "shelf",
+               "toilet_brush", "bath_scale", "mirror", "cabinet", "bench"], int(r.rng.integers(1, 4)))
 
 
 def _kitchen(r: RoomBuilder) -> None:
@@ -544,7 +553,7 @@ MIN_FLOOR_OBJECTS = 6
 CLUTTER = {"bedroom": ["floor_lamp", "armchair", "laundry_basket", "trash_can", "plant", "ottoman"],
            "living": ["armchair", "floor_lamp", "plant", "ottoman", "side_table"],
            "office": ["plant", "floor_lamp", "trash_can", "coat_rack", "filing_cabinet"],
-           "bathroom": ["trash_can", "towel_rack", "laundry_basket", "hamper", "stool"],
+           "bathroom": ["trash_can", "towel_rack", "laundry_basket", "hamper", "stool", "toilet_brush", "bath_scale"],
            "kitchen": ["trash_can", "stool", "plant", "shelf"]}
 RECIPES = {"bedroom": _bedroom, "living": _living, "office": _office, "bathroom": _bathroom, "kitchen": _kitchen}
 REQUIRED = {"bedroom": {"bed"}, "living": {"sofa", "armchair"}, "office": {"desk"},
@@ -564,7 +573,7 @@ def generate_room(index: int, room_type: str, seed: int, models: dict[str, list[
     if defect == "room_size":
         size = (6.4, 7.8)
     height = float(rng.uniform(4.3, 5.0)) if defect == "room_height" else float(rng.uniform(2.5, 3.0))
-    r = RoomBuilder(f"proc_{room_type}_{index:05d}", room_type, rng, models)
+    r = RoomBuilder(f"proc_{room_type}_{index:05d}", room_type, rng, models, index=index)
     r.make_shell(bool(rng.random() < l_shape_rate), size, height)
     RECIPES[content_type](r)
     for _ in range(8):  # top up sparse rooms with clutter so clean rooms pass the object-count bounds
@@ -594,7 +603,7 @@ def _apply_defect(r: RoomBuilder, defect: str) -> None:
         m = r.model("ottoman")
         r.add("ottoman", m, host.cx + float(r.rng.uniform(-0.05, 0.05)), host.cy, host.yaw)
     elif defect == "rare_category":
-        cat = str(r.rng.choice(catalog.RARE))
+        cat = catalog.RARE[r.index % len(catalog.RARE)]  # spread over the list so each stays rare
         m = r.model(cat)
         if r.free_group([(cat, m, 0.0, 0.0, 0.0)]) is None:
             c = r.outline.mean(axis=0)

@@ -18,14 +18,14 @@ def box(extents, centre=(0.0, 0.0, 0.0)) -> Mesh:
     return _pair(m)
 
 
-def cylinder(radius: float, height: float, centre=(0.0, 0.0, 0.0), sections: int = 16) -> Mesh:
+def cylinder(radius: float, height: float, centre=(0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
     """Vertical cylinder."""
     m = trimesh.creation.cylinder(radius=radius, height=height, sections=sections)
     m.apply_translation(centre)
     return _pair(m)
 
 
-def cone(radius: float, height: float, base=(0.0, 0.0, 0.0), sections: int = 16) -> Mesh:
+def cone(radius: float, height: float, base=(0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
     """Vertical cone standing on ``base``."""
     m = trimesh.creation.cone(radius=radius, height=height, sections=sections)
     m.apply_translation(base)

@@ -28,13 +28,41 @@ def intersector_class(backend: str):
             raise BackendError("extract.backend is 'embree' but trimesh cannot load embreex (pip install "
                                "embreex==4.4.0.post1; there is no wheel for Linux aarch64). Set extract.backend: "
                                "python to use trimesh's pure-Python backend instead (about 1000x slower).")
-        from trimesh.ray.ray_pyembree import RayMeshIntersector
-        return RayMeshIntersector
+        return EmbreeIntersector
     if backend == "python":
         warnings.warn("using trimesh's pure-Python ray backend: about 1000x slower than Embree", RuntimeWarning, stacklevel=2)
         from trimesh.ray.ray_triangle import RayMeshIntersector
         return RayMeshIntersector
     raise BackendError(f"unknown ray backend '{backend}' (embree | python)")
+
+
+class EmbreeIntersector:
+    """First-hit queries on one triangle mesh through embreex, sharing one Embree device across scenes.
+
+    trimesh's own Embree wrapper rehashes the mesh on every query and builds a new device per scene;
+    for thousands of small per-room scenes those costs dominate, so the extraction talks to embreex
+    directly (same library, same float32 Embree kernels) and keeps trimesh for meshes and the
+    pure-Python fallback. Vertices are stored relative to the mesh's minimum corner for float32 precision.
+    """
+
+    _device = None
+
+    def __init__(self, mesh: trimesh.Trimesh) -> None:
+        from embreex import rtcore, rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+
+        if EmbreeIntersector._device is None:
+            EmbreeIntersector._device = rtcore.EmbreeDevice()
+        vertices = np.asarray(mesh.vertices, dtype=np.float64)
+        self.origin = vertices.min(axis=0) if len(vertices) else np.zeros(3)
+        self.scene = rtcore_scene.EmbreeScene(EmbreeIntersector._device)
+        TriangleMesh(scene=self.scene, vertices=(vertices - self.origin).astype(np.float32),
+                     indices=np.asarray(mesh.faces, dtype=np.int32))
+
+    def intersects_first(self, ray_origins: np.ndarray, ray_directions: np.ndarray) -> np.ndarray:
+        """Index of the first triangle each ray hits, -1 for none (directions must be unit vectors)."""
+        origins = (np.asarray(ray_origins, dtype=np.float64) - self.origin).astype(np.float32)
+        return self.scene.run(origins, np.asarray(ray_directions, dtype=np.float32))
 
 
 class RoomScene:
@@ -54,39 +82,52 @@ class RoomScene:
         self.owner = np.repeat(np.asarray(owners, dtype=np.int64), counts)
         self.layer = np.repeat(np.asarray(layers, dtype=np.int8), counts)
         mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False, validate=False)
+        v0 = vertices[faces[:, 0]]
+        self._normal = np.cross(vertices[faces[:, 1]] - v0, vertices[faces[:, 2]] - v0)
+        self._offset = np.einsum("ij,ij->i", self._normal, v0)  # face planes: normal . x = offset
+        self._step = max(1e-8, float(np.ptp(vertices, axis=0).max()) * 1e-6)
         self._rays = intersector(mesh)
 
-    def hits(self, origins: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Every hit of every ray, sorted by ray then distance.
+    def first_accepted(self, origins: np.ndarray, directions: np.ndarray, accept, max_dist=np.inf,
+                       max_steps: int = 256) -> tuple[np.ndarray, np.ndarray]:
+        """Nearest hit per ray that ``accept`` takes, stepping through the hits it refuses.
 
-        Returns ``(ray (k,) int, owner (k,) int, layer (k,) int, distance (k,) float)``; directions must be
-        unit vectors.
+        ``accept(ray (k,), owner (k,), layer (k,)) -> (k,) bool``. A ray retires at its first accepted hit,
+        when it leaves the scene, or beyond ``max_dist`` (scalar or per ray). Directions must be unit vectors.
+        Returns ``owner (n,)`` (-1: none) and ``distance (n,)`` (inf: none).
         """
         origins = np.array(origins, dtype=np.float64).reshape(-1, 3)
         directions = np.array(directions, dtype=np.float64).reshape(-1, 3)
-        if len(origins) == 0:
-            return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int8), np.zeros(0)
-        tri, ray, loc = self._rays.intersects_id(ray_origins=origins.copy(), ray_directions=directions.copy(),
-                                                 multiple_hits=True, return_locations=True)
-        tri, ray = np.asarray(tri, dtype=np.int64), np.asarray(ray, dtype=np.int64)
-        loc = np.asarray(loc, dtype=float).reshape(-1, 3)
-        dist = np.einsum("ij,ij->i", loc - origins[ray], directions[ray])
-        order = np.lexsort((dist, ray))
-        tri = tri[order]
-        return ray[order], self.owner[tri], self.layer[tri], dist[order]
-
-
-def first_accepted(ray: np.ndarray, owner: np.ndarray, dist: np.ndarray, accept: np.ndarray,
-                   n_rays: int) -> tuple[np.ndarray, np.ndarray]:
-    """Nearest accepted hit per ray: ``(owner (n_rays,), distance (n_rays,))``, -1 / inf where none.
-
-    ``accept`` is a boolean mask over the hits (sorted by ray then distance, as :meth:`RoomScene.hits` returns).
-    """
-    best_owner = np.full(n_rays, -1, dtype=np.int64)
-    best_dist = np.full(n_rays, np.inf)
-    r, o, d = ray[accept], owner[accept], dist[accept]
-    if len(r):
-        first = np.unique(r, return_index=True)[1]
-        best_owner[r[first]] = o[first]
-        best_dist[r[first]] = d[first]
-    return best_owner, best_dist
+        n = len(origins)
+        best_owner = np.full(n, -1, dtype=np.int64)
+        best_dist = np.full(n, np.inf)
+        travelled = np.zeros(n)
+        limit = np.broadcast_to(np.asarray(max_dist, dtype=float), (n,))
+        live = np.arange(n)
+        at = origins.copy()
+        last = np.full(n, -1, dtype=np.int64)
+        for _ in range(max_steps):
+            if not len(live):
+                break
+            tri = np.asarray(self._rays.intersects_first(ray_origins=at[live], ray_directions=directions[live]), np.int64)
+            hit = tri >= 0
+            live, tri = live[hit], tri[hit]
+            d = directions[live]
+            nrm = self._normal[tri]
+            denom = np.einsum("ij,ij->i", nrm, d)
+            flat = denom == 0
+            step = (self._offset[tri] - np.einsum("ij,ij->i", nrm, at[live])) / np.where(flat, 1.0, denom)
+            step = np.where(flat, 0.0, np.maximum(step, 0.0))
+            dist = travelled[live] + step
+            inside = dist <= limit[live]
+            live, tri, d, step, dist = live[inside], tri[inside], d[inside], step[inside], dist[inside]
+            ok = accept(live, self.owner[tri], self.layer[tri])
+            best_owner[live[ok]] = self.owner[tri[ok]]
+            best_dist[live[ok]] = dist[ok]
+            live, tri, d, step = live[~ok], tri[~ok], d[~ok], step[~ok]
+            stuck = last[live] == tri  # re-hit the same face: push further
+            push = self._step * np.where(stuck, 64.0, 1.0)
+            at[live] += d * (step + push)[:, None]
+            travelled[live] += step + push
+            last[live] = tri
+        return best_owner, best_dist

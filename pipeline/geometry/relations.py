@@ -54,6 +54,8 @@ def choose_parents(obj: np.ndarray, hit_owner: np.ndarray, hit_dist: np.ndarray,
     none). Ties go to the larger object (``size``). Returns ``parent (n,)`` (-1: floor) and ``area (n,)`` m^2.
     """
     n = len(cell_area)
+    if n == 0:
+        return np.zeros(0, np.int64), np.zeros(0)
     ok = (hit_owner >= 0) & (hit_dist <= reach)
     counts = np.zeros((n, n))
     np.add.at(counts, (obj[ok], hit_owner[ok]), 1.0)

@@ -25,8 +25,8 @@ TRANSFORMS = {
     "rot90": _rot(np.pi / 2),
     "rot_odd": _rot(2 * np.pi / 7),  # an angle no polygonal object of a few sides keeps
     "rot_45": _rot(np.pi / 4),
-    "diag": np.array([[0, 1.0, 0], [1.0, 0, 0], [0, 0, 1]]),  # reflect across y = x
-    "antidiag": np.array([[0, -1.0, 0], [-1.0, 0, 0], [0, 0, 1]]),  # reflect across y = -x
+    "diag": np.array([[0, 1.0, 0], [1.0, 0, 0], [0, 0, 1]]),  # reflect across y = x (corner-left)
+    "antidiag": np.array([[0, -1.0, 0], [-1.0, 0, 0], [0, 0, 1]]),  # reflect across y = -x (corner-right)
 }
 
 
@@ -64,10 +64,10 @@ def classify(inv: dict[str, bool]) -> str:
         return "left-right"
     if inv["mirror_y"]:
         return "front-back"
-    if inv["diag"]:
-        return "corner-right"
-    if inv["antidiag"]:
+    if inv["diag"]:  # mirror axis through the back-left and front-right corners
         return "corner-left"
+    if inv["antidiag"]:  # mirror axis through the back-right and front-left corners
+        return "corner-right"
     return "none"
 
 

@@ -12,6 +12,7 @@ import pyarrow as pa
 from .. import tables
 from ..config import config_hash
 from ..extraction import extract_room
+from ..roomdata import room_inputs
 from ..geometry.raycast import intersector_class
 from ..log import progress
 from .symmetry import model_mesh
@@ -49,17 +50,12 @@ def run(config: dict, shard: int, ingest_dir: str | Path, filter_dir: str | Path
             return table[category], "table"
         return by_model.get(model_id, ("none", "default"))
 
-    arch_by_room = dict(tuple(arch.groupby("room_id", sort=False)))
-    objs_by_room = dict(tuple(objs.groupby("room_id", sort=False)))
     nodes, edges, skipped = [], [], []
     rays, cycles = 0, 0
     start = time.perf_counter()
-    for room in progress(list(rooms.itertuples(index=False)), desc=f"extract shard {shard}"):
-        a = arch_by_room.get(room.room_id, arch.iloc[:0])
-        kind = a["kind"].astype(str)
+    for room in progress(room_inputs(rooms, arch, objs), total=len(rooms), desc=f"extract shard {shard}"):
         try:
-            g = extract_room(room, a[kind == "wall"], a[kind != "wall"], objs_by_room.get(room.room_id, objs.iloc[:0]),
-                             models.get, symmetry_of, cfg, intersector)
+            g = extract_room(room, models.get, symmetry_of, cfg, intersector)
         except ValueError as exc:
             log.warning("room %s skipped: %s", room.room_id, exc)
             skipped.append({"room_id": room.room_id, "node_id": None, "reason": str(exc)})

@@ -1,0 +1,82 @@
+"""Extraction speed: rays/s and rooms/s with Embree on the default procedural corpus, and with trimesh's
+pure-Python backend on a few of the same rooms in the same run (the ratio).
+
+    .venv/bin/python bench/extraction.py [--workdir bench/out] [--rooms 1000] [--python-rooms 4]
+
+Builds the default corpus (config/config.yaml) under --workdir if it is not there yet.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+import warnings
+from pathlib import Path
+
+from pipeline import config as config_mod
+from pipeline.extraction import extract_room
+from pipeline.geometry.raycast import intersector_class
+from pipeline.roomdata import room_inputs
+from pipeline.stages import filter as filter_stage, ingest, symmetry
+from pipeline.stages.extract import load_shard
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def corpus(workdir: Path, cfg: dict) -> None:
+    if not (workdir / "filter" / "rooms.parquet").exists():
+        ingest.run(cfg, workdir / "ingest")
+        filter_stage.run(cfg, workdir / "ingest", workdir / "filter")
+    if not (workdir / "symmetry" / "symmetry.parquet").exists():
+        symmetry.run(cfg, workdir / "ingest", workdir / "symmetry")
+
+
+def run(workdir: Path, rooms_wanted: int, python_rooms: int) -> dict:
+    cfg = config_mod.load(ROOT / "config" / "config.yaml", json.dumps({"shards": 1}))
+    corpus(workdir, cfg)
+    rooms, arch, objs, models = load_shard(workdir / "ingest", workdir / "filter", 0)
+    inputs = list(room_inputs(rooms, arch, objs))[:rooms_wanted]
+    sym = lambda c, m: ("none", "default")  # noqa: E731  symmetry does not change the ray work
+    ex = cfg["extract"]
+    result = {"rooms": len(inputs), "objects": int(sum(len(r.object_ids) for r in inputs)),
+              "machine": f"{platform.processor() or platform.machine()}, 1 core (single process)"}
+    embree = intersector_class("embree")
+    extract_room(inputs[0], models.get, sym, ex, embree)  # warm-up
+    t, rays = time.perf_counter(), 0
+    for r in inputs:
+        rays += extract_room(r, models.get, sym, ex, embree).rays
+    dt = time.perf_counter() - t
+    result["embree"] = {"seconds": round(dt, 3), "rooms_per_s": round(len(inputs) / dt, 1), "rays": rays,
+                        "rays_per_s": round(rays / dt)}
+    subset = inputs[:python_rooms]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        slow = intersector_class("python")
+    t_fast = time.perf_counter()
+    for r in subset:
+        extract_room(r, models.get, sym, ex, embree)
+    t_fast = time.perf_counter() - t_fast
+    t, rays = time.perf_counter(), 0
+    for r in subset:
+        rays += extract_room(r, models.get, sym, ex, slow).rays
+    dt = time.perf_counter() - t
+    result["python"] = {"rooms": len(subset), "seconds": round(dt, 3), "rooms_per_s": round(len(subset) / dt, 3),
+                        "rays_per_s": round(rays / dt), "slowdown_vs_embree_same_rooms": round(dt / t_fast, 1)}
+    return result
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--workdir", type=Path, default=ROOT / "bench" / "out")
+    ap.add_argument("--rooms", type=int, default=1000)
+    ap.add_argument("--python-rooms", type=int, default=4)
+    args = ap.parse_args()
+    result = run(args.workdir, args.rooms, args.python_rooms)
+    args.workdir.mkdir(parents=True, exist_ok=True)
+    (args.workdir / "extraction.json").write_text(json.dumps(result, indent=2))
+    print(json.dumps(result, indent=2))
+
+
+if __name__ == "__main__":
+    main()

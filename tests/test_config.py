@@ -1,0 +1,72 @@
+import json
+import re
+import tomllib
+
+import pytest
+import yaml
+
+from pipeline import config
+from conftest import ROOT
+
+
+def test_defaults_fill_every_section():
+    cfg = config.validate({})
+    assert cfg["source"] == "procedural" and cfg["shards"] == 4
+    assert cfg["filter"]["max_penetration"] == 0.15
+    assert cfg["extract"]["distance"]["adjacent_abs"] == 0.0508
+    assert cfg["extract"]["support"]["max_distance"] == 0.10
+
+
+def test_repo_config_is_valid_and_has_2000_rooms():
+    cfg = config.load(ROOT / "config" / "config.yaml")
+    assert sum(cfg["procedural"]["rooms"].values()) >= 2000
+
+
+def test_bad_value_names_the_key(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("filter:\n  max_height: -1\n")
+    with pytest.raises(config.ConfigError, match=r"bad.yaml: invalid config at key 'filter.max_height'"):
+        config.load(bad)
+
+
+def test_unknown_key_is_rejected(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("extract:\n  suport: {grid: 3}\n")
+    with pytest.raises(config.ConfigError, match=r"key 'extract'.*suport"):
+        config.load(bad)
+
+
+def test_unreadable_and_malformed_files(tmp_path):
+    with pytest.raises(config.ConfigError, match="cannot read config"):
+        config.load(tmp_path / "missing.yaml")
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("shards: [1,\n")
+    with pytest.raises(config.ConfigError, match="broken.yaml: not valid YAML"):
+        config.load(broken)
+    with pytest.raises(config.ConfigError, match="--config-json: not valid JSON"):
+        config.load(None, "{nope")
+
+
+def test_json_overrides_merge_deeply():
+    cfg = config.load(ROOT / "config" / "config.yaml", json.dumps({"filter": {"max_height": 3.5}}))
+    assert cfg["filter"]["max_height"] == 3.5
+    assert cfg["filter"]["max_extent"] == 6.0
+
+
+def _norm(name: str) -> str:
+    return {"python-duckdb": "duckdb", "pytorch": "torch"}.get(name, name).lower().replace("_", "-")
+
+
+def test_environment_yml_matches_pyproject():
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    pins = {}
+    for spec in project["dependencies"] + sum(project["optional-dependencies"].values(), []):
+        name, op, version = re.match(r"([A-Za-z0-9_.-]+)\s*(==|>=)\s*([^;\s]+)", spec).groups()
+        pins[_norm(name)] = (op, version)
+    env = yaml.safe_load((ROOT / "environment.yml").read_text())
+    conda = {}
+    for dep in env["dependencies"]:
+        m = re.match(r"([A-Za-z0-9_.-]+)\s*(=|>=)\s*(\S+)", dep)
+        if m and m.group(1) != "python":
+            conda[_norm(m.group(1))] = ("==" if m.group(2) == "=" else ">=", m.group(3))
+    assert conda == pins

@@ -1,0 +1,83 @@
+"""Real Snakemake runs of the whole workflow on the tiny config (config/tiny.yaml)."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from pipeline import tables
+from conftest import ROOT
+
+pytestmark = pytest.mark.slow
+BIN = Path(sys.executable).parent
+
+
+def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path | None = None) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PATH": f"{BIN}{os.pathsep}{os.environ['PATH']}"}
+    configs = [str(ROOT / "config" / "tiny.yaml")] + ([str(extra_config)] if extra_config else [])
+    cmd = [str(BIN / "snakemake"), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(workdir),
+           "--configfile", *configs, "--cores", "2", *args]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=900)
+    if check and proc.returncode != 0:
+        raise AssertionError(f"snakemake failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
+    return proc
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory):
+    work = tmp_path_factory.mktemp("e2e")
+    snakemake(work)
+    return work
+
+
+def test_every_table_has_its_schema(run_dir):
+    res = run_dir / "results"
+    expected = {"ingest/rooms.parquet": "rooms", "ingest/architecture.parquet": "architecture",
+                "ingest/objects.parquet": "objects", "ingest/models.parquet": "models",
+                "ingest/ground_truth.parquet": "ground_truth", "filter/report.parquet": "filter_report",
+                "filter/rooms.parquet": "rooms", "symmetry/symmetry.parquet": "symmetry",
+                "graphs/raw/nodes-0.parquet": "nodes", "graphs/raw/nodes-1.parquet": "nodes",
+                "graphs/raw/edges-0.parquet": "edges", "graphs/raw/edges-1.parquet": "edges"}
+    for rel, name in expected.items():
+        schema = pq.read_schema(res / rel)
+        assert schema.remove_metadata().equals(tables.SCHEMAS[name].remove_metadata()), rel
+        assert tables.metadata(res / rel)["pipeline.schema"] == f"{name}/v1"
+
+
+def test_contents_are_consistent(run_dir):
+    res = run_dir / "results"
+    rooms = pq.read_table(res / "ingest/rooms.parquet").to_pandas()
+    report = pq.read_table(res / "filter/report.parquet").to_pandas()
+    kept = pq.read_table(res / "filter/rooms.parquet").to_pandas()
+    assert len(rooms) == 26 and set(report.room_id) == set(rooms.room_id)
+    assert (report.status == "rejected").sum() >= 1 and report.loc[report.status == "rejected", "rule"].notna().all()
+    assert set(kept.shard) <= {0, 1}
+    nodes = pq.read_table(res / "graphs/raw/nodes-0.parquet").to_pandas()
+    assert set(nodes.room_id) == set(kept.loc[kept.shard == 0, "room_id"])
+    metrics = json.loads((res / "metrics/extraction.json").read_text())
+    assert metrics["support_parent_accuracy"] >= 0.98 and metrics["adjacent_recall"] >= 0.95
+    for log in ["ingest/ingest.log", "filter_rooms/filter_rooms.log", "extract_graphs/0.log", "symmetry/symmetry.log"]:
+        assert (run_dir / "logs" / log).stat().st_size > 0, log
+
+
+def test_second_run_has_nothing_to_do(run_dir):
+    out = snakemake(run_dir, "--dry-run")
+    assert "Nothing to be done" in out.stdout + out.stderr
+
+
+def test_changing_a_filter_threshold_reruns_only_downstream(run_dir, tmp_path):
+    override = tmp_path / "override.yaml"
+    override.write_text("filter:\n  max_height: 3.9\n  min_category_rooms: 1\n")
+    out = snakemake(run_dir, "--dry-run", extra_config=override)
+    text = out.stdout
+    assert "filter_rooms" in text and "extract_graphs" in text
+    assert "rule ingest:" not in text and "rule symmetry:" not in text
+
+
+def test_invalid_config_names_the_key(tmp_path):
+    out = snakemake(tmp_path, "--dry-run", "--config", "shards=0", check=False)
+    assert out.returncode != 0
+    assert "shards" in out.stderr + out.stdout and "minimum" in out.stderr + out.stdout

@@ -1,0 +1,53 @@
+import os
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from pipeline import tables
+
+
+def rows():
+    return [{"room_id": "r1", "element_id": "wall_0", "kind": "wall", "x0": 0.0, "y0": 0.0, "x1": 1.0, "y1": 0.0,
+             "z0": 0.0, "z1": 2.5, "thickness": 0.1, "wall_id": None}]
+
+
+def test_round_trip_keeps_schema_units_and_metadata(tmp_path):
+    path = tables.write(tmp_path / "a.parquet", "architecture", tables.from_rows("architecture", rows()), {"source": "test"})
+    back = tables.read(path, "architecture")
+    assert back.schema.equals(tables.SCHEMAS["architecture"], check_metadata=False)
+    assert back.to_pylist()[0]["x1"] == 1.0
+    schema = pq.read_schema(path)
+    assert schema.field("x0").metadata[b"unit"] == b"m"
+    meta = tables.metadata(path)
+    assert meta["pipeline.schema"] == "architecture/v1" and meta["pipeline.source"] == "test"
+    assert "Z up" in meta["pipeline.coordinates"]
+
+
+def test_failed_write_leaves_nothing_behind(tmp_path):
+    bad = pa.table({"room_id": ["r1"]})  # lacks every other field
+    with pytest.raises(tables.TableError, match="lacks fields"):
+        tables.write(tmp_path / "b.parquet", "architecture", bad)
+    assert os.listdir(tmp_path) == []
+
+
+def test_write_replaces_atomically(tmp_path):
+    path = tmp_path / "c.parquet"
+    tables.write(path, "architecture", tables.from_rows("architecture", rows()))
+    two = rows() * 2
+    tables.write(path, "architecture", tables.from_rows("architecture", two))
+    assert tables.read(path).num_rows == 2
+    assert sorted(os.listdir(tmp_path)) == ["c.parquet"]
+
+
+def test_read_errors_name_file_and_field(tmp_path):
+    with pytest.raises(tables.TableError, match="no such table file"):
+        tables.read(tmp_path / "nope.parquet")
+    junk = tmp_path / "junk.parquet"
+    junk.write_text("not parquet")
+    with pytest.raises(tables.TableError, match="junk.parquet: not a readable Parquet file"):
+        tables.read(junk)
+    partial = tmp_path / "partial.parquet"
+    pq.write_table(pa.table({"room_id": ["r"], "element_id": ["w"]}), partial)
+    with pytest.raises(tables.TableError, match=r"partial.parquet: table 'architecture' lacks field\(s\) kind"):
+        tables.read(partial, "architecture")
