@@ -10,6 +10,7 @@ configfile: "config/config.yaml"
 include: "rules/common.smk"
 include: "rules/ingest.smk"
 include: "rules/extract.smk"
+include: "rules/refine.smk"
 
 
 rule all:

@@ -38,7 +38,7 @@ def _guard(fn, *args, **kwargs):
 
     try:
         return fn(*args, **kwargs)
-    except (TableError, BackendError, config_mod.ConfigError, NotImplementedError, FileNotFoundError) as exc:
+    except (TableError, BackendError, config_mod.ConfigError, NotImplementedError, FileNotFoundError, KeyError) as exc:
         _fail(str(exc))
 
 
@@ -112,9 +112,76 @@ def score(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonO
         typer.echo(f"{key}: {value}")
 
 
+@app.command("graph-stats")
+def graph_stats(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                raw_dir: Path = typer.Option(Path("results/graphs/raw"), "--raw"),
+                out: Path = typer.Option(Path("results/graphs/stats"))) -> None:
+    """Dataset-wide statistics over every shard's raw graphs: co-occurrence, relation frequencies, hub patterns, sizes."""
+    from .stages import graphs as stage
+
+    cfg = _config(config, config_json)
+    summary = _guard(stage.run_statistics, cfg, raw_dir, out)
+    typer.echo(" ".join(f"{k}={v}" for k, v in summary.items()))
+
+
 @app.command()
-def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table")) -> None:
-    """Print a table's schema, metadata, row count and per-column summary."""
+def refine(shard: int = typer.Option(..., help="shard index"), config: Optional[Path] = ConfigOpt,
+           config_json: Optional[str] = JsonOpt,
+           raw_dir: Path = typer.Option(Path("results/graphs/raw"), "--raw"),
+           stats_dir: Path = typer.Option(Path("results/graphs/stats"), "--stats"),
+           out: Path = typer.Option(Path("results/graphs/final"))) -> None:
+    """Superstructures, pruning and connectivity repair for one shard's raw graphs."""
+    from .stages import graphs as stage
+
+    cfg = _config(config, config_json)
+    summary = _guard(stage.run_refine, cfg, shard, raw_dir, stats_dir, out)
+    typer.echo(" ".join(f"{k}={v}" for k, v in summary.items() if k != "cyclic_room_ids"))
+
+
+@app.command("gather-graphs")
+def gather_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                  final_dir: Path = typer.Option(Path("results/graphs/final"), "--final"),
+                  out: Path = typer.Option(Path("results/graphs"))) -> None:
+    """Concatenate the refined shards into results/graphs/{nodes,edges,superstructures}.parquet."""
+    from .stages import graphs as stage
+
+    cfg = _config(config, config_json)
+    counts = _guard(stage.run_gather, cfg, final_dir, out)
+    typer.echo(" ".join(f"{k}={v}" for k, v in counts.items()))
+
+
+@app.command("score-graphs")
+def score_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                 ingest_dir: Path = typer.Option(Path("results/ingest"), "--ingest"),
+                 graph_dir: Path = typer.Option(Path("results/graphs"), "--graphs"),
+                 out: Path = typer.Option(Path("results/metrics/superstructures.json"))) -> None:
+    """Hub and chain precision / recall against the source's ground truth."""
+    from .stages import score as stage
+
+    cfg = _config(config, config_json)
+    metrics = _guard(stage.run_superstructures, cfg, ingest_dir, graph_dir, out)
+    for key, value in metrics.items():
+        typer.echo(f"{key}: {value}")
+
+
+@app.command()
+def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, or 'graphs' / a folder of final graph tables"),
+          room: Optional[str] = typer.Option(None, "--room", help="print this room's graph"),
+          out: Optional[Path] = typer.Option(None, "--out", help="graphs: where to write the CSVs and the PNG")) -> None:
+    """Print a table's schema, row count and per-column summary; for graphs, the per-room-type report."""
+    if str(path) == "graphs" and not path.exists():
+        path = Path("results/graphs")
+    if path.is_dir():
+        from .graphs.report import graph_report, print_report, print_room, write_report
+
+        if room:
+            _guard(print_room, path, room, sys.stdout)
+            return
+        report = _guard(graph_report, path)
+        print_report(report, sys.stdout)
+        for p in write_report(report, out or path / "report"):
+            typer.echo(f"wrote {p}")
+        return
     from .inspect import table_summary
 
     _guard(table_summary, path, sys.stdout)

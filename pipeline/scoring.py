@@ -34,3 +34,30 @@ def adjacency_scores(edges: pd.DataFrame, gt: pd.DataFrame) -> dict:
 
 def _ratio(a, b) -> float | None:
     return round(float(a) / float(b), 4) if b else None
+
+
+def _groups(frame: pd.DataFrame, anchor: str, member: str) -> set[tuple]:
+    """(room, anchor, frozenset of members) per group."""
+    out = set()
+    for (room, _), g in frame.groupby(["room_id", "group_id"]):
+        out.add((room, g[anchor].iloc[0], frozenset(g[member])))
+    return out
+
+
+def superstructure_scores(supers: pd.DataFrame, gt: pd.DataFrame) -> dict:
+    """Hub and chain precision / recall against the generator's groups (exact hub + spoke set, exact chain member set)."""
+    out = {}
+    for kind in ("hub", "chain"):
+        truth = gt[gt["relation"].astype(str) == kind]
+        found = supers[supers["kind"].astype(str) == kind]
+        t = _groups(truth, "anchor_id", "target_id") if len(truth) else set()
+        f = _groups(found, "anchor_id", "member_id") if len(found) else set()
+        if kind == "chain":  # a chain is the same whichever end it is read from
+            t = {(r, m) for r, _, m in t}
+            f = {(r, m) for r, _, m in f}
+        hit = len(t & f)
+        out[f"{kind}s_true"] = len(t)
+        out[f"{kind}s_found"] = len(f)
+        out[f"{kind}_precision"] = _ratio(hit, len(f))
+        out[f"{kind}_recall"] = _ratio(hit, len(t))
+    return out

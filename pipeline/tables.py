@@ -171,6 +171,46 @@ SCHEMAS: dict[str, pa.Schema] = {
     ]),
 }
 
+# refinement adds columns to the raw graph tables
+SCHEMAS["final_nodes"] = pa.schema([*SCHEMAS["nodes"], _f("role", _CAT, doc="hub | spoke | chain_start | chain_member | chain_end | none (chain roles may combine with hub roles: 'hub+chain_start')"),
+                                    _f("group_id", _STR, doc="the hub or chain the node belongs to")])
+SCHEMAS["final_edges"] = pa.schema([*SCHEMAS["edges"],
+                                    _f("status", _CAT, doc="kept | pruned"),
+                                    _f("rule", _CAT, doc="the rule that kept or pruned the edge (docs/data-model.md lists them)"),
+                                    _f("origin", _CAT, doc="raw (extracted) | derived (added by hub/chain inheritance or connectivity)"),
+                                    _f("group_id", _STR, doc="hub or chain whose edge this is")])
+SCHEMAS["superstructures"] = pa.schema([
+    _f("room_id", _STR, nullable=False), _f("room_type", _CAT),
+    _f("group_id", _STR, doc="hub_<k> | chain_<k>, unique within the room"),
+    _f("kind", _CAT, doc="hub | chain"),
+    _f("anchor_id", _STR, doc="the hub, or the chain's start"),
+    _f("member_id", _STR, doc="a spoke, or a chain member (the start included)"),
+    _f("position", _I32, doc="chain: index along the chain"),
+    _f("direction", _CAT, doc="hub: spoke direction from the hub; chain: direction of its edges"),
+    _f("label", _CAT, doc="chain: adjacent | proximal"),
+])
+SCHEMAS["cooccurrence"] = pa.schema([
+    _f("room_type", _CAT), _f("cat_a", _STR), _f("cat_b", _STR),
+    _f("rooms", pa.int64(), doc="rooms holding both (a room counts once; a == b needs two instances)"),
+])
+SCHEMAS["relations"] = pa.schema([
+    _f("room_type", _CAT), _f("cat_a", _STR, doc="anchor category"), _f("cat_b", _STR, doc="target category"),
+    _f("direction", _CAT), _f("distance", _CAT),
+    _f("rooms", pa.int64(), doc="rooms with at least one such raw edge"),
+    _f("cooccur_rooms", pa.int64(), doc="rooms where both categories occur"),
+    _f("freq", _F64, doc="rooms / cooccur_rooms: the share the pruning thresholds apply to"),
+])
+SCHEMAS["hub_patterns"] = pa.schema([
+    _f("room_type", _CAT), _f("hub_category", _STR), _f("spoke_category", _STR),
+    _f("count", pa.int64(), doc="candidate hub arrangements seen in the raw graphs"),
+    _f("accepted", pa.bool_(), doc="count >= refine.hub_min_pattern_count"),
+])
+SCHEMAS["category_sizes"] = pa.schema([
+    _f("room_type", _CAT), _f("category", _STR), _f("instances", pa.int64()),
+    _f("mean_area", _F64, "m^2", "mean projected (footprint) box area"),
+    _f("mean_diag", _F64, "m", "mean footprint diagonal"),
+])
+
 
 def empty(name: str) -> pa.Table:
     return SCHEMAS[name].empty_table()

@@ -22,5 +22,6 @@ def get_final_outputs():
     return [
         "results/filter/report.parquet",
         "results/metrics/extraction.json",
-        *expand("results/graphs/raw/edges-{shard}.parquet", shard=SHARDS),
+        "results/metrics/superstructures.json",
+        "results/graphs/report/table1.csv",
     ]

@@ -47,7 +47,7 @@ rule score_extraction:
     output:
         metrics="results/metrics/extraction.json",
     params:
-        settings=stage_json("source"),
+        settings=stage_json("source", "shards"),
     log:
         "logs/score_extraction/score_extraction.log",
     shell:

@@ -40,7 +40,11 @@ def test_every_table_has_its_schema(run_dir):
                 "ingest/ground_truth.parquet": "ground_truth", "filter/report.parquet": "filter_report",
                 "filter/rooms.parquet": "rooms", "symmetry/symmetry.parquet": "symmetry",
                 "graphs/raw/nodes-0.parquet": "nodes", "graphs/raw/nodes-1.parquet": "nodes",
-                "graphs/raw/edges-0.parquet": "edges", "graphs/raw/edges-1.parquet": "edges"}
+                "graphs/raw/edges-0.parquet": "edges", "graphs/raw/edges-1.parquet": "edges",
+                "graphs/stats/relations.parquet": "relations", "graphs/stats/hub_patterns.parquet": "hub_patterns",
+                "graphs/stats/cooccurrence.parquet": "cooccurrence", "graphs/stats/category_sizes.parquet": "category_sizes",
+                "graphs/final/edges-1.parquet": "final_edges", "graphs/nodes.parquet": "final_nodes",
+                "graphs/edges.parquet": "final_edges", "graphs/superstructures.parquet": "superstructures"}
     for rel, name in expected.items():
         schema = pq.read_schema(res / rel)
         assert schema.remove_metadata().equals(tables.SCHEMAS[name].remove_metadata()), rel
@@ -59,7 +63,13 @@ def test_contents_are_consistent(run_dir):
     assert set(nodes.room_id) == set(kept.loc[kept.shard == 0, "room_id"])
     metrics = json.loads((res / "metrics/extraction.json").read_text())
     assert metrics["support_parent_accuracy"] >= 0.98 and metrics["adjacent_recall"] >= 0.95
-    for log in ["ingest/ingest.log", "filter_rooms/filter_rooms.log", "extract_graphs/0.log", "symmetry/symmetry.log"]:
+    sup = json.loads((res / "metrics/superstructures.json").read_text())
+    assert sup["hubs_true"] > 0 and sup["hub_recall"] >= 0.8 and sup["chain_recall"] >= 0.8
+    edges = pq.read_table(res / "graphs/edges.parquet").to_pandas()
+    assert set(edges.status) == {"kept", "pruned"} and edges.rule.notna().all()
+    assert (res / "graphs/report/graph_stats.png").stat().st_size > 1000
+    for log in ["ingest/ingest.log", "filter_rooms/filter_rooms.log", "extract_graphs/0.log", "symmetry/symmetry.log",
+                "graph_statistics/graph_statistics.log", "refine_graphs/1.log"]:
         assert (run_dir / "logs" / log).stat().st_size > 0, log
 
 
@@ -73,8 +83,16 @@ def test_changing_a_filter_threshold_reruns_only_downstream(run_dir, tmp_path):
     override.write_text("filter:\n  max_height: 3.9\n  min_category_rooms: 1\n")
     out = snakemake(run_dir, "--dry-run", extra_config=override)
     text = out.stdout
-    assert "filter_rooms" in text and "extract_graphs" in text
+    assert "filter_rooms" in text and "extract_graphs" in text and "refine_graphs" in text
     assert "rule ingest:" not in text and "rule symmetry:" not in text
+
+
+def test_forcerun_refine_reruns_only_refinement_and_after(run_dir):
+    out = snakemake(run_dir, "--dry-run", "--forcerun", "refine_graphs")
+    text = out.stdout
+    assert "refine_graphs" in text and "gather_graphs" in text and "score_superstructures" in text
+    for upstream in ("rule ingest:", "rule filter_rooms:", "rule extract_graphs:", "rule graph_statistics:"):
+        assert upstream not in text
 
 
 def test_invalid_config_names_the_key(tmp_path):

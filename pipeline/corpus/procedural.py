@@ -332,7 +332,7 @@ class RoomBuilder:
         back = float(self.rng.uniform(0.05, 0.25))
         pieces, x = [], 0.0
         for _ in range(n):
-            pieces.append(("plant", m, x + m.w / 2, back + m.d / 2, float(self.rng.uniform(-3, 3))))
+            pieces.append(("plant", m, x + m.w / 2, back + m.d / 2, float(self.rng.normal(0, 0.03))))
             x += m.w + float(self.rng.uniform(0.15, 0.3))
         placed = self.wall_group(pieces)
         if placed is None:
