@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 CORES ?= 2
 
-.PHONY: setup pipeline test bench clean
+.PHONY: setup pipeline test test-slurm bench clean
 
 setup: $(VENV)/.installed
 
@@ -21,6 +21,9 @@ pipeline: setup
 
 test: setup
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest -q -ra
+
+test-slurm: setup
+	timeout -s INT 900 bash tests/slurm/run.sh
 
 bench: setup
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python bench/run_all.py

@@ -136,8 +136,20 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) 
     reach = sc["start_offset"] + sc["max_distance"]
     first_owner, first_dist = scene.first_accepted(
         s_orig, s_dir, lambda r, own, lay: (lay == MESH) & (own != s_obj[r]), max_dist=reach)
-    parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, volume)
-    parent, cycles = relations.break_support_cycles(parent, volume)
+    if sc["inside_box_contact"]:
+        # grid points whose ray finds nothing within reach but that lie in another object's box rest in or on
+        # the smallest such box (box-only sources, whose boxes reach above their support surface: cushions on
+        # beds, things in fridges); a face level with the object's own bottom hides behind the bottom itself,
+        # so the point just below the bottom is tested too
+        miss = first_dist > reach
+        owner_in, _ = relations.containing_box(s_orig[miss], b, s_obj[miss], volume)
+        below = s_orig[miss] - [0.0, 0.0, sc["start_offset"] + 1e-3]
+        owner_in = np.where(owner_in >= 0, owner_in, relations.containing_box(below, b, s_obj[miss], volume)[0])
+        first_owner[miss] = np.where(owner_in >= 0, owner_in, first_owner[miss])
+        first_dist[miss] = np.where(owner_in >= 0, 0.0, first_dist[miss])
+    footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
+    parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
+    parent, cycles = relations.break_support_cycles(parent, footprint)
     area[parent < 0] = 0.0
     g.support_cycles = len(cycles)
     tier = relations.tiers(parent)

@@ -25,6 +25,10 @@ _F64 = pa.float64()
 _I32 = pa.int32()
 
 
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
+
 class TableError(ValueError):
     """A table file is unreadable or lacks a field; the message names the file and field."""
 
@@ -254,6 +258,7 @@ def write(path: str | Path, name: str, table: pa.Table, extra: dict | None = Non
     os.close(fd)
     try:
         pq.write_table(table, tmp, compression="zstd")
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; shared (cluster) filesystems need the usual mode
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

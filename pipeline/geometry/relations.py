@@ -65,6 +65,26 @@ def choose_parents(obj: np.ndarray, hit_owner: np.ndarray, hit_dist: np.ndarray,
     return parent, area
 
 
+def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volume: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each point, the smallest box (other than ``own``) that contains it; -1 where none.
+
+    ``points (k, 3)``, ``boxes (n, 7)``, ``own (k,)`` box index to ignore per point. Returns the box index and
+    a (k, n) containment mask.
+    """
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    if not len(points) or not len(b):
+        return np.full(len(points), -1, dtype=np.int64), np.zeros((len(points), len(b)), bool)
+    rel = points[:, None, :2] - b[None, :, :2]  # (k, n, 2)
+    c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
+    lx = rel[..., 0] * c + rel[..., 1] * s
+    ly = -rel[..., 0] * s + rel[..., 1] * c
+    inside = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (np.abs(points[:, None, 2] - b[:, 2]) <= b[:, 5])
+    inside[np.arange(len(points)), own] = False
+    vol = np.where(inside, volume[None, :], np.inf)
+    best = np.argmin(vol, axis=1)
+    return np.where(np.isfinite(vol[np.arange(len(points)), best]), best, -1), inside
+
+
 def break_support_cycles(parent: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
     """Un-parent the largest object of every support cycle. Returns the new parents and the cycles found."""
     parent = parent.copy()

@@ -45,7 +45,67 @@ def ingest_procedural(config: dict) -> dict[str, pa.Table]:
             "ground_truth": tables.from_rows("ground_truth", gt), "ingest_report": tables.from_rows("ingest_report", report)}
 
 
-SOURCES = {"procedural": ingest_procedural}
+def _report_rows(source: str, report: Counter) -> list[dict]:
+    return [{"source": source, "item": reason if kind != "object" or status != "kept" else reason, "kind": kind,
+             "status": status, "reason": reason, "count": n} for (kind, status, reason), n in sorted(report.items())]
+
+
+def _tables(rooms, arch, objs, models, gt, report_rows) -> dict[str, pa.Table]:
+    return {"rooms": tables.from_rows("rooms", rooms), "architecture": tables.from_rows("architecture", arch),
+            "objects": tables.from_rows("objects", objs), "models": tables.from_rows("models", models),
+            "ground_truth": tables.from_rows("ground_truth", gt), "ingest_report": tables.from_rows("ingest_report", report_rows)}
+
+
+def ingest_front3d(config: dict) -> dict[str, pa.Table]:
+    from ..corpus import front3d
+
+    cfg = config["front3d"]
+    houses_dir, future = Path(cfg["houses"]), Path(cfg["future"])
+    if not houses_dir.is_dir():
+        raise FileNotFoundError(f"front3d.houses: no such folder '{houses_dir}'")
+    if not future.is_dir():
+        raise FileNotFoundError(f"front3d.future: no such folder '{future}'")
+    opt = lambda key: Path(cfg[key]) if cfg[key] else None  # noqa: E731
+    catalogue = front3d.Catalogue.load(future, opt("models_csv"), opt("category_csv"), opt("model_info"))
+    cache = front3d.MeshCache(future, opt("cache_dir"))
+    files = sorted(houses_dir.glob("*.json"))[: cfg["max_houses"]]
+    report: Counter = Counter()
+    rooms, arch, objs, models = [], [], [], {}
+    for f in progress(files, desc="3D-FRONT houses"):
+        try:
+            out = front3d.parse_house(f, catalogue, cache, cfg, report)
+        except front3d.HouseError as exc:
+            log.warning("house skipped: %s", exc)
+            report[("house", "skipped", str(exc))] += 1
+            continue
+        report[("house", "read", "ok")] += 1
+        rooms += out["rooms"]
+        arch += out["architecture"]
+        objs += out["objects"]
+        for k, v in out["models"].items():
+            models.setdefault(k, v)
+    report[("model", "kept", f"meshes parsed {cache.parsed}, from cache {cache.hits}")] += len(models)
+    return _tables(rooms, arch, objs, list(models.values()), [], _report_rows("front3d", report))
+
+
+def ingest_ithor(config: dict) -> dict[str, pa.Table]:
+    from ..corpus import ithor
+
+    cfg = config["ithor"]
+    data, path = ithor.load(cfg)
+    report: Counter = Counter()
+    out = {k: [] for k in ("rooms", "architecture", "objects", "models", "ground_truth")}
+    for group in cfg["groups"]:
+        if group not in data or group not in ithor.GROUPS:
+            raise KeyError(f"{path}: no room group '{group}' (ithor.groups; known: {sorted(ithor.GROUPS)})")
+        for k, objects in enumerate(progress(data[group], desc=f"AI2-THOR {group}")):
+            for name, rows in ithor.parse_room(group, k, objects, cfg, report).items():
+                out[name] += rows
+    return _tables(out["rooms"], out["architecture"], out["objects"], out["models"], out["ground_truth"],
+                   _report_rows("ithor", report))
+
+
+SOURCES = {"procedural": ingest_procedural, "front3d": ingest_front3d, "ithor": ingest_ithor}
 
 
 def run(config: dict, out_dir: str | Path) -> dict[str, int]:
@@ -61,4 +121,6 @@ def run(config: dict, out_dir: str | Path) -> dict[str, int]:
                      extra={"source": source, "config_hash": config_hash(section)})
     counts = {name: result[name].num_rows for name in OUTPUTS}
     log.info("ingested %s: %s", source, counts)
+    for row in result["ingest_report"].to_pylist():
+        log.info("  %-8s %-9s %6d  %s", row["kind"], row["status"], row["count"], row["reason"] or row["item"])
     return counts

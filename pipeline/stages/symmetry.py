@@ -18,8 +18,8 @@ log = logging.getLogger("planit.symmetry")
 
 def model_mesh(row: dict) -> tuple[np.ndarray, np.ndarray]:
     """(vertices (n, 3), faces (m, 3)) of a ``models`` table row."""
-    v = np.asarray(row["vertices"] or [], dtype=float).reshape(-1, 3)
-    f = np.asarray(row["faces"] or [], dtype=np.int64).reshape(-1, 3)
+    v = np.asarray(row["vertices"] if row["vertices"] is not None else [], dtype=float).reshape(-1, 3)
+    f = np.asarray(row["faces"] if row["faces"] is not None else [], dtype=np.int64).reshape(-1, 3)
     return v, f
 
 

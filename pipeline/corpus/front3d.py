@@ -1,0 +1,325 @@
+"""3D-FRONT houses with 3D-FUTURE furniture -> canonical tables.
+
+A house JSON lists furniture (``uid`` -> 3D-FUTURE ``jid``), architecture meshes in world coordinates and
+rooms whose ``children`` reference both. Everything is converted once, here, from 3D-FRONT's Y-up frame to
+the project's Z-up frame: world ``(x, y, z) -> (x, -z, y)``; 3D-FUTURE models face +z, so model space is
+``(x, y, z) -> (-x, z, y)`` (front = +Y) and an object's yaw gains pi.
+"""
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+import logging
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import shapely
+from shapely.ops import unary_union
+
+from ..geometry import meshes as M
+from ..geometry.polygon import make_ccw, merge_collinear, polygon_segments, signed_area
+
+log = logging.getLogger("planit.front3d")
+
+WORLD = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])  # Y-up world -> Z-up world
+MODEL = np.array([[-1.0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]])  # Y-up model (front +z) -> Z-up model (front +y)
+CM_EXTENT = 5.0  # m: a model whose extent exceeds this is in centimetres
+OPENINGS = {"Door": "door", "Hole": "door", "Window": "window", "BayWindow": "window"}
+
+
+class HouseError(ValueError):
+    """A house file that cannot be parsed; the message names the file and the field."""
+
+
+def norm_category(name: str | None) -> str | None:
+    """3D-FUTURE category as the field writes it: lower case, ' / ' -> '/'."""
+    return None if not name else name.strip().lower().replace(" / ", "/")
+
+
+@dataclass
+class Catalogue:
+    """3D-FUTURE model metadata: categories and boxes (model space, Z-up, metres)."""
+    category: dict[str, str] = field(default_factory=dict)
+    box: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+
+    @classmethod
+    def load(cls, future: Path, models_csv: Path | None, category_csv: Path | None, model_info: Path | None) -> "Catalogue":
+        cat = cls()
+        info = model_info or future / "model_info.json"
+        if info.exists():
+            data = json.loads(info.read_text())
+            if isinstance(data, list):  # the 3D-FUTURE release: [{model_id, category, super-category, ...}]
+                for m in data:
+                    c = norm_category(m.get("category")) or norm_category(m.get("super-category"))
+                    if m.get("model_id") and c:
+                        cat.category[m["model_id"]] = c
+        mapping = category_csv or future / "ModelCategoryMapping.csv"
+        if mapping.exists():
+            with open(mapping, newline="") as fh:
+                for row in csv.DictReader(fh):
+                    c = norm_category(row.get("category")) or norm_category(row.get("super-category"))
+                    if c:
+                        cat.category.setdefault(row["model_id"], c)
+        boxes = models_csv or future / "Models.csv"
+        if boxes.exists():
+            with open(boxes, newline="") as fh:
+                for row in csv.DictReader(fh):
+                    try:
+                        lo = np.array([float(v) for v in row["minPoint"].split(",") if v.strip() != ""])
+                        hi = np.array([float(v) for v in row["maxPoint"].split(",") if v.strip() != ""])
+                    except (KeyError, ValueError) as exc:
+                        raise HouseError(f"{boxes}: model {row.get('id')}: bad minPoint/maxPoint ({exc})") from exc
+                    if lo.shape != (3,) or hi.shape != (3,):
+                        continue  # malformed rows (a few have an empty coordinate) fall back to no box
+                    if (hi - lo).max() > CM_EXTENT:
+                        lo, hi = lo / 100.0, hi / 100.0
+                    corners = np.array([lo, hi]) @ MODEL.T
+                    cat.box[row["id"]] = (corners.min(axis=0), corners.max(axis=0))
+        return cat
+
+
+class MeshCache:
+    """3D-FUTURE ``raw_model.obj`` meshes in Z-up model space, parsed once and cached as .npz by file
+    size and modification time, so a re-run does not re-parse OBJ files."""
+
+    def __init__(self, future: Path, cache_dir: Path | None) -> None:
+        self.future = future
+        self.cache_dir = cache_dir
+        self.hits = self.parsed = 0
+
+    def get(self, model_id: str) -> tuple[np.ndarray, np.ndarray, str] | None:
+        path = self.future / model_id / "raw_model.obj"
+        if not path.exists():
+            path = self.future / "models" / model_id / "raw_model.obj"
+        if not path.exists():
+            return None
+        stat = path.stat()
+        key = hashlib.sha1(f"{path.resolve()}:{stat.st_size}:{stat.st_mtime_ns}".encode()).hexdigest()[:16]
+        cached = self.cache_dir / f"{model_id}-{key}.npz" if self.cache_dir else None
+        if cached is not None and cached.exists():
+            with np.load(cached) as z:
+                self.hits += 1
+                return z["v"], z["f"], str(path)
+        import trimesh
+
+        try:
+            mesh = trimesh.load(path, force="mesh", process=False)
+        except Exception as exc:  # trimesh raises many kinds for broken OBJ files
+            log.warning("%s: unreadable mesh (%s); using the box", path, exc)
+            return None
+        v = np.asarray(mesh.vertices, float)
+        f = np.asarray(mesh.faces, np.int64)
+        if len(v) == 0 or len(f) == 0:
+            return None
+        if np.ptp(v, axis=0).max() > CM_EXTENT:
+            v = v / 100.0
+        v = v @ MODEL.T
+        self.parsed += 1
+        if cached is not None:
+            cached.parent.mkdir(parents=True, exist_ok=True)
+            tmp = cached.with_name(cached.name + ".tmp.npz")
+            np.savez_compressed(tmp, v=v.astype(np.float32), f=f.astype(np.int32))
+            tmp.replace(cached)
+        return v, f, str(path)
+
+
+def yaw_from_quaternion(q) -> tuple[float, float]:
+    """Yaw (about Z-up) of a 3D-FRONT [x, y, z, w] rotation and how far it tilts the up axis (radians)."""
+    x, y, z, w = (float(c) for c in q)
+    n = math.sqrt(x * x + y * y + z * z + w * w) or 1.0
+    x, y, z, w = x / n, y / n, z / n, w / n
+    r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    rz = WORLD @ r @ WORLD.T
+    tilt = math.acos(max(-1.0, min(1.0, rz[2, 2])))
+    return math.atan2(rz[1, 0], rz[0, 0]), tilt
+
+
+def _outline(floor_meshes: list[dict], file: Path) -> np.ndarray:
+    tris = []
+    for m in floor_meshes:
+        try:
+            xyz = np.asarray(m["xyz"], float).reshape(-1, 3) @ WORLD.T
+            faces = np.asarray(m["faces"], np.int64).reshape(-1, 3)
+        except (KeyError, ValueError) as exc:
+            raise HouseError(f"{file}: mesh {m.get('uid')}: bad 'xyz'/'faces' ({exc})") from exc
+        tris += [shapely.Polygon(xyz[t, :2]) for t in faces if abs(signed_area(xyz[t, :2])) > 1e-9]
+    union = unary_union(tris).buffer(1e-4).buffer(-1e-4)
+    if union.is_empty:
+        raise ValueError("Floor meshes have no area")
+    poly = max(getattr(union, "geoms", [union]), key=lambda p: p.area)
+    outline = np.asarray(poly.simplify(0.01).exterior.coords)[:-1]
+    return merge_collinear(make_ccw(outline), tol=1e-3)
+
+
+def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, report: Counter) -> dict[str, list]:
+    """Rooms of one house as canonical rows: {'rooms', 'architecture', 'objects', 'models'}.
+
+    Rooms without a Floor mesh, of an unmapped type or without valid furniture are skipped (counted in
+    ``report`` with the reason). A malformed house raises HouseError naming the file and field.
+    """
+    try:
+        house = json.loads(Path(file).read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise HouseError(f"{file}: not readable JSON ({exc})") from exc
+    for key in ("uid", "furniture", "mesh", "scene"):
+        if key not in house:
+            raise HouseError(f"{file}: missing field '{key}'")
+    if "room" not in house["scene"]:
+        raise HouseError(f"{file}: missing field 'scene.room'")
+    furniture = {f["uid"]: f for f in house["furniture"] if "uid" in f}
+    arch_meshes = {m["uid"]: m for m in house["mesh"] if "uid" in m}
+    out = {"rooms": [], "architecture": [], "objects": [], "models": {}}
+    for room in house["scene"]["room"]:
+        rtype_src = room.get("type", "")
+        room_id = f"{house['uid']}_{room.get('instanceid', rtype_src)}"
+        rtype = cfg["room_types"].get(rtype_src)
+        if rtype is None:
+            report[("room", "skipped", f"room type '{rtype_src}' not mapped")] += 1
+            continue
+        children = room.get("children", [])
+        room_meshes = [arch_meshes[c["ref"]] for c in children if c.get("ref") in arch_meshes]
+        floors = [m for m in room_meshes if m.get("type") == "Floor"]
+        if not floors:
+            report[("room", "skipped", "no Floor mesh")] += 1
+            continue
+        valid = [c for c in children if c.get("ref") in furniture and furniture[c["ref"]].get("valid")
+                 and furniture[c["ref"]].get("jid")]
+        if not valid:
+            report[("room", "skipped", "no valid furniture")] += 1
+            continue
+        try:
+            outline = _outline(floors, file)
+        except ValueError as exc:
+            report[("room", "skipped", str(exc))] += 1
+            continue
+        floor_z = min(float(np.min(np.asarray(m["xyz"], float).reshape(-1, 3)[:, 1])) for m in floors)
+        ceilings = [m for m in room_meshes if m.get("type") == "Ceiling"]
+        height = (max(float(np.max(np.asarray(m["xyz"], float).reshape(-1, 3)[:, 1])) for m in ceilings) - floor_z
+                  if ceilings else cfg["default_height"])
+        segs = polygon_segments(outline)
+        walls = []
+        for i, s in enumerate(segs):
+            walls.append({"room_id": room_id, "element_id": f"wall_{i}", "kind": "wall", "x0": s[0][0], "y0": s[0][1],
+                          "x1": s[1][0], "y1": s[1][1], "z0": 0.0, "z1": height, "thickness": cfg["wall_thickness"],
+                          "wall_id": None})
+        out["architecture"] += walls + _openings(room_id, room_meshes, segs, floor_z)
+        objects = []
+        for c in valid:
+            row = _object(room_id, len(objects), furniture[c["ref"]], c, catalogue, meshes, out["models"], floor_z,
+                          category_map(cfg, rtype), report)
+            if row is not None:
+                objects.append(row)
+        floor = shapely.Polygon(outline).buffer(cfg["outside_tolerance"])
+        inside = [o for o in objects if floor.contains(shapely.Point(o["cx"], o["cy"]))]
+        if len(inside) < len(objects):
+            report[("object", "dropped", "centre outside its room's floor outline")] += len(objects) - len(inside)
+        objects = [dict(o, object_id=f"obj_{k:02d}") for k, o in enumerate(inside)]
+        if not objects:
+            report[("room", "skipped", "no furniture with a mesh or box inside the floor outline")] += 1
+            out["architecture"] = [a for a in out["architecture"] if a["room_id"] != room_id]
+            continue
+        xs, ys = outline[:, 0], outline[:, 1]
+        out["rooms"].append({"room_id": room_id, "source": "front3d", "room_type": rtype, "source_room_type": rtype_src,
+                             "floor_x": xs.tolist(), "floor_y": ys.tolist(), "height": height,
+                             "floor_area": signed_area(outline), "extent_x": float(np.ptp(xs)),
+                             "extent_y": float(np.ptp(ys)), "n_objects": len(objects), "shard": None})
+        out["objects"] += objects
+        report[("room", "read", rtype)] += 1
+    return out
+
+
+def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: float) -> list[dict]:
+    """Door and window meshes of the room, projected onto their nearest wall."""
+    rows, counts = [], Counter()
+    d = segs[:, 1] - segs[:, 0]
+    length = np.linalg.norm(d, axis=1)
+    u = d / length[:, None]
+    for m in room_meshes:
+        kind = OPENINGS.get(m.get("type"))
+        if kind is None:
+            continue
+        xyz = np.asarray(m.get("xyz", []), float).reshape(-1, 3) @ WORLD.T
+        if not len(xyz):
+            continue
+        c = xyz[:, :2].mean(axis=0)
+        rel = c - segs[:, 0]
+        t = np.einsum("ij,ij->i", rel, u)
+        off = np.abs(rel[:, 0] * u[:, 1] - rel[:, 1] * u[:, 0])
+        off = np.where((t >= -0.05) & (t <= length + 0.05), off, np.inf)
+        w = int(np.argmin(off))
+        if off[w] > 0.4:
+            continue  # not on this room's walls
+        ts = (xyz[:, :2] - segs[w, 0]) @ u[w]
+        t0, t1 = float(np.clip(ts.min(), 0, length[w])), float(np.clip(ts.max(), 0, length[w]))
+        if t1 - t0 < 0.05:
+            continue
+        p0, p1 = segs[w, 0] + u[w] * t0, segs[w, 0] + u[w] * t1
+        k = counts[kind]
+        counts[kind] += 1
+        rows.append({"room_id": room_id, "element_id": f"{kind}_{k}", "kind": kind, "x0": p0[0], "y0": p0[1],
+                     "x1": p1[0], "y1": p1[1], "z0": float(xyz[:, 2].min() - floor_z), "z1": float(xyz[:, 2].max() - floor_z),
+                     "thickness": None, "wall_id": f"wall_{w}"})
+    return rows
+
+
+def category_map(cfg: dict, room_type: str) -> dict[str, str]:
+    """The category map for a room type: the '*' entries, overridden by the room type's own."""
+    maps = cfg["category_map"]
+    return {**maps.get("*", {}), **maps.get(room_type, {})}
+
+
+def _object(room_id, k, furn, child, catalogue, meshes, models, floor_z, cmap, report) -> dict | None:
+    jid = furn["jid"]
+    category = catalogue.category.get(jid) or norm_category(furn.get("category")) or norm_category(furn.get("title"))
+    if not category:
+        report[("object", "dropped", "no category")] += 1
+        return None
+    category = cmap.get(category, category)
+    if jid not in models:
+        mesh = meshes.get(jid)
+        if mesh is not None:
+            v, f, path = mesh
+            kind = "mesh"
+        elif jid in catalogue.box:
+            lo, hi = catalogue.box[jid]
+            v, f = M.box(hi - lo, (lo + hi) / 2)
+            path, kind = None, "box_fallback"
+            report[("model", "fallback", "box from Models.csv (no raw_model.obj)")] += 1
+        else:
+            report[("object", "dropped", "no mesh and no box for its model")] += 1
+            return None
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        models[jid] = {"model_id": jid, "category": category, "source": "front3d",
+                       "vertices": np.asarray(v, np.float32).ravel().tolist(), "faces": np.asarray(f, np.int32).ravel().tolist(),
+                       "mesh_kind": kind, "mesh_path": path, "min_x": lo[0], "min_y": lo[1], "min_z": lo[2],
+                       "max_x": hi[0], "max_y": hi[1], "max_z": hi[2]}
+    m = models[jid]
+    try:
+        pos = np.asarray(child["pos"], float) @ WORLD.T
+        yaw, tilt = yaw_from_quaternion(child.get("rot", [0, 0, 0, 1]))
+        sx, sy, sz = (float(s) for s in child.get("scale", [1, 1, 1]))
+    except (KeyError, ValueError, TypeError) as exc:
+        report[("object", "dropped", f"bad pos/rot/scale ({type(exc).__name__})")] += 1
+        return None
+    if tilt > math.radians(5):
+        report[("object", "kept", "tilted more than 5 degrees: yaw kept only")] += 1
+    yaw += math.pi  # Y-up models face +z, ours +y: see the module docstring
+    scale = np.array([sx, sz, sy])
+    lo = np.array([m["min_x"], m["min_y"], m["min_z"]])
+    hi = np.array([m["max_x"], m["max_y"], m["max_z"]])
+    centre_local = scale * (lo + hi) / 2
+    half = np.abs(scale) * (hi - lo) / 2
+    c, s = math.cos(yaw), math.sin(yaw)
+    p = pos - [0.0, 0.0, floor_z]
+    centre = p + [c * centre_local[0] - s * centre_local[1], s * centre_local[0] + c * centre_local[1], centre_local[2]]
+    report[("object", "kept", category)] += 1
+    return {"room_id": room_id, "object_id": f"obj_{k:02d}", "category": category, "model_id": jid,
+            "cx": centre[0], "cy": centre[1], "cz": centre[2], "hx": half[0], "hy": half[1], "hz": half[2],
+            "yaw": yaw, "px": p[0], "py": p[1], "pz": p[2], "sx": scale[0], "sy": scale[1], "sz": scale[2],
+            "source_parent_id": None}
