@@ -58,6 +58,6 @@ def superstructure_scores(supers: pd.DataFrame, gt: pd.DataFrame) -> dict:
         hit = len(t & f)
         out[f"{kind}s_true"] = len(t)
         out[f"{kind}s_found"] = len(f)
-        out[f"{kind}_precision"] = _ratio(hit, len(f))
+        out[f"{kind}_precision"] = _ratio(hit, len(f)) if t else None  # a source without such ground truth scores nothing
         out[f"{kind}_recall"] = _ratio(hit, len(t))
     return out

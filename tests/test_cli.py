@@ -54,6 +54,6 @@ def test_invalid_config_file_names_the_key(tmp_path):
     assert out.returncode == 2 and "procedural.defect_rate" in out.stderr
 
 
-def test_unimplemented_source_is_a_clear_error(tmp_path):
-    out = planit("ingest", "--config-json", '{"source": "suncg"}', "--out", str(tmp_path / "i"))
-    assert out.returncode == 2 and "suncg" in out.stderr
+def test_missing_source_folder_is_a_clear_error(tmp_path):
+    out = planit("ingest", "--config-json", '{"source": "front3d", "front3d": {"houses": "/nowhere"}}', "--out", str(tmp_path / "i"))
+    assert out.returncode == 2 and "front3d.houses" in out.stderr and "/nowhere" in out.stderr

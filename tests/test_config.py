@@ -65,7 +65,11 @@ def test_environment_yml_matches_pyproject():
         pins[_norm(name)] = (op, version)
     env = yaml.safe_load((ROOT / "environment.yml").read_text())
     conda = {}
+    deps = []
     for dep in env["dependencies"]:
+        deps += dep["pip"] if isinstance(dep, dict) else [dep]
+    for dep in deps:
+        dep = dep.replace("==", "=")
         m = re.match(r"([A-Za-z0-9_.-]+)\s*(=|>=)\s*(\S+)", dep)
         if m and m.group(1) != "python":
             conda[_norm(m.group(1))] = ("==" if m.group(2) == "=" else ">=", m.group(3))

@@ -140,6 +140,17 @@ def yaw_from_quaternion(q) -> tuple[float, float]:
     return math.atan2(rz[1, 0], rz[0, 0]), tilt
 
 
+def outline_of_triangles(xy_tris: list[np.ndarray]) -> np.ndarray:
+    """Counter-clockwise outline of the union of floor triangles (each (3, 2)); the largest piece if several."""
+    polys = [shapely.Polygon(t) for t in xy_tris if abs(signed_area(t)) > 1e-9]
+    union = unary_union(polys).buffer(1e-4).buffer(-1e-4)
+    if union.is_empty:
+        raise ValueError("Floor meshes have no area")
+    poly = max(getattr(union, "geoms", [union]), key=lambda p: p.area)
+    outline = np.asarray(poly.simplify(0.01).exterior.coords)[:-1]
+    return merge_collinear(make_ccw(outline), tol=1e-3)
+
+
 def _outline(floor_meshes: list[dict], file: Path) -> np.ndarray:
     tris = []
     for m in floor_meshes:
@@ -148,13 +159,8 @@ def _outline(floor_meshes: list[dict], file: Path) -> np.ndarray:
             faces = np.asarray(m["faces"], np.int64).reshape(-1, 3)
         except (KeyError, ValueError) as exc:
             raise HouseError(f"{file}: mesh {m.get('uid')}: bad 'xyz'/'faces' ({exc})") from exc
-        tris += [shapely.Polygon(xyz[t, :2]) for t in faces if abs(signed_area(xyz[t, :2])) > 1e-9]
-    union = unary_union(tris).buffer(1e-4).buffer(-1e-4)
-    if union.is_empty:
-        raise ValueError("Floor meshes have no area")
-    poly = max(getattr(union, "geoms", [union]), key=lambda p: p.area)
-    outline = np.asarray(poly.simplify(0.01).exterior.coords)[:-1]
-    return merge_collinear(make_ccw(outline), tol=1e-3)
+        tris += [xyz[t, :2] for t in faces]
+    return outline_of_triangles(tris)
 
 
 def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, report: Counter) -> dict[str, list]:

@@ -105,7 +105,36 @@ def ingest_ithor(config: dict) -> dict[str, pa.Table]:
                    _report_rows("ithor", report))
 
 
-SOURCES = {"procedural": ingest_procedural, "front3d": ingest_front3d, "ithor": ingest_ithor}
+def ingest_suncg(config: dict) -> dict[str, pa.Table]:
+    from ..corpus import front3d, suncg
+
+    cfg = config["suncg"]
+    houses = Path(cfg["houses"])
+    files = [houses] if houses.is_file() else sorted(houses.glob("*/house.json"))
+    if not files:
+        raise FileNotFoundError(f"suncg.houses: no house.json under '{houses}'")
+    room_folder = Path(cfg["room_folder"]) if cfg["room_folder"] else None
+    report: Counter = Counter()
+    out = {k: [] for k in ("rooms", "architecture", "objects", "models")}
+    for f in progress(files, desc="SUNCG houses"):
+        try:
+            parsed = suncg.parse_house(f, room_folder, report)
+        except front3d.HouseError as exc:
+            log.warning("house skipped: %s", exc)
+            report[("house", "skipped", str(exc))] += 1
+            continue
+        report[("house", "read", "ok")] += 1
+        for k in out:
+            out[k] += parsed[k]
+    if not out["rooms"]:
+        reasons = "; ".join(r for (kind, status, r) in report if kind == "house" and status == "skipped")
+        raise FileNotFoundError(f"source suncg: no room could be read: {reasons}")
+    models = {m["model_id"]: m for m in out["models"]}
+    return _tables(out["rooms"], out["architecture"], out["objects"], list(models.values()), [],
+                   _report_rows("suncg", report))
+
+
+SOURCES = {"procedural": ingest_procedural, "front3d": ingest_front3d, "ithor": ingest_ithor, "suncg": ingest_suncg}
 
 
 def run(config: dict, out_dir: str | Path) -> dict[str, int]:

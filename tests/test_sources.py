@@ -1,0 +1,161 @@
+"""Real-data sources on the project's own fixtures (tests/fixtures) and, where present, on ../shared/data."""
+import json
+import math
+import subprocess
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import shapely
+
+from pipeline import config
+from pipeline.corpus import front3d, ithor, suncg
+from pipeline.stages import ingest
+from conftest import ROOT, shared_data
+
+FIX = Path(__file__).parent / "fixtures"
+
+
+def run_ingest(source: str, section: dict, tmp_path) -> dict[str, pd.DataFrame]:
+    cfg = config.validate({"source": source, source: section})
+    ingest.run(cfg, tmp_path / "ingest")
+    return {name: pd.read_parquet(tmp_path / "ingest" / f"{name}.parquet") for name in ingest.OUTPUTS}
+
+
+# ----------------------------------------------------------------------------------------------- 3D-FRONT
+def test_front3d_fixture_house(tmp_path):
+    t = run_ingest("front3d", {"houses": str(FIX / "front3d/houses"), "future": str(FIX / "front3d/future"),
+                               "cache_dir": str(tmp_path / "cache")}, tmp_path)
+    rooms, objs, arch, models, rep = t["rooms"], t["objects"], t["architecture"], t["models"], t["ingest_report"]
+    assert rooms.room_id.tolist() == ["tinyhouse_MasterBedroom-1"] and rooms.room_type.tolist() == ["bedroom"]
+    assert rooms.extent_x[0] == pytest.approx(4.0) and rooms.extent_y[0] == pytest.approx(3.0)
+    assert rooms.height[0] == pytest.approx(2.8)
+    assert sorted(objs.category) == ["king-size bed", "nightstand"]  # the chair has neither mesh nor box: dropped
+    bed = objs[objs.category == "king-size bed"].iloc[0]
+    # centimetre OBJ scaled to metres; back (-Y) against the wall at y = 0, facing +y
+    assert (2 * bed.hx, 2 * bed.hy, 2 * bed.hz) == pytest.approx((1.6, 2.0, 1.0), abs=1e-6)
+    assert (bed.cx, bed.cy, bed.cz) == pytest.approx((2.0, 1.01, 0.5), abs=1e-6)
+    assert math.cos(bed.yaw) == pytest.approx(1.0, abs=1e-6)
+    ns = objs[objs.category == "nightstand"].iloc[0]
+    assert (2 * ns.hx, 2 * ns.hy, 2 * ns.hz) == pytest.approx((0.5, 0.4, 0.55), abs=1e-6)  # Models.csv in cm
+    assert set(models.mesh_kind) == {"mesh", "box_fallback"}
+    door = arch[arch.kind == "door"].iloc[0]
+    wall = arch[(arch.kind == "wall") & (arch.element_id == door.wall_id)].iloc[0]
+    assert wall.y0 == pytest.approx(3.0) and wall.y1 == pytest.approx(3.0)  # the door sits in the y = 3 wall
+    assert abs(door.x1 - door.x0) == pytest.approx(0.9) and door.z1 == pytest.approx(2.0)
+    reasons = dict(zip(rep.reason, rep["count"]))
+    assert reasons["no mesh and no box for its model"] == 1
+    assert reasons["room type 'Balcony' not mapped"] == 1 and reasons["no Floor mesh"] == 1
+    assert reasons["box from Models.csv (no raw_model.obj)"] == 1
+    assert any("broken.json: missing field 'mesh'" in r for r in rep.reason)  # reported, run continued
+    # the OBJ was cached: a second run reads the cache, not the file
+    cache = front3d.MeshCache(FIX / "front3d/future", tmp_path / "cache")
+    assert cache.get("jid-bed") is not None and (cache.hits, cache.parsed) == (1, 0)
+
+
+def test_front3d_quaternion_to_yaw():
+    yaw, tilt = front3d.yaw_from_quaternion([0, math.sin(math.pi / 4), 0, math.cos(math.pi / 4)])  # 90° about +Y
+    assert yaw == pytest.approx(math.pi / 2) and tilt == pytest.approx(0.0, abs=1e-9)
+    assert front3d.norm_category("Lounge Chair / Cafe Chair") == "lounge chair/cafe chair"
+
+
+def _independent_counts(houses: Path, room_types: dict) -> tuple[int, int]:
+    """Rooms with a Floor mesh, a mapped type and valid furniture; and their valid furniture children."""
+    rooms = objects = 0
+    for f in sorted(houses.glob("*.json")):
+        h = json.loads(f.read_text())
+        mesh_types = {m["uid"]: m.get("type") for m in h["mesh"]}
+        furn = {x["uid"]: x for x in h["furniture"]}
+        for r in h["scene"]["room"]:
+            kids = r.get("children", [])
+            valid = [c for c in kids if furn.get(c.get("ref"), {}).get("valid") and furn[c["ref"]].get("jid")]
+            if r.get("type") in room_types and "Floor" in {mesh_types.get(c.get("ref")) for c in kids} and valid:
+                rooms += 1
+                objects += len(valid)
+    return rooms, objects
+
+
+@pytest.mark.realdata
+def test_front3d_real_sample_houses(tmp_path):
+    sample = shared_data("3d-front-sample")
+    section = {"houses": str(sample / "houses"), "future": str(sample / "3d-future"), "cache_dir": str(tmp_path / "c")}
+    t = run_ingest("front3d", section, tmp_path)
+    rooms, objs, rep = t["rooms"], t["objects"], t["ingest_report"]
+    assert not (rep.kind.eq("house") & rep.status.eq("skipped")).any()  # every house parses
+    want_rooms, want_objects = _independent_counts(sample / "houses", config.validate({})["front3d"]["room_types"])
+    dropped = rep[(rep.kind == "object") & (rep.status == "dropped")]["count"].sum()
+    emptied = rep[(rep.kind == "room") & rep.reason.str.contains("inside the floor outline")]["count"].sum()
+    assert len(rooms) + emptied == want_rooms and emptied <= 1  # one sample room has all its furniture off its floor
+    assert len(objs) + dropped == want_objects
+    for room in rooms.itertuples():
+        floor = shapely.Polygon(np.column_stack([room.floor_x, room.floor_y])).buffer(0.05 + 1e-6)
+        o = objs[objs.room_id == room.room_id]
+        assert shapely.contains_xy(floor, o.cx.to_numpy(), o.cy.to_numpy()).all(), room.room_id
+        assert (o.cz - o.hz > -0.05).all(), room.room_id  # nothing below the floor
+
+
+@pytest.mark.realdata
+@pytest.mark.slow
+def test_front3d_real_sample_runs_through_refinement(tmp_path):
+    sample = shared_data("3d-front-sample")
+    cfg = (ROOT / "config/front3d.yaml").read_text()
+    cfg = cfg.replace("houses: data/3D-FRONT", f"houses: {sample / 'houses'}").replace(
+        "future: data/3D-FUTURE-model", f"future: {sample / '3d-future'}")
+    (tmp_path / "cfg.yaml").write_text(cfg)
+    bin_ = Path(sys.executable).parent
+    out = subprocess.run([str(bin_ / "snakemake"), "--snakefile", str(ROOT / "Snakefile"), "-d", str(tmp_path),
+                          "--configfile", str(tmp_path / "cfg.yaml"), "--cores", "2", "-q"], capture_output=True, text=True,
+                         env={"PATH": f"{bin_}:/usr/bin:/bin"}, timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    edges = pd.read_parquet(tmp_path / "results/graphs/edges.parquet")
+    assert edges.room_id.nunique() >= 10 and set(edges.status) == {"kept", "pruned"}
+    assert (tmp_path / "results/graphs/report/table1.csv").exists()
+
+
+# ----------------------------------------------------------------------------------------------- AI2-THOR
+def test_ithor_fixture_room(tmp_path):
+    t = run_ingest("ithor", {"metadata": str(FIX / "ithor/metadata.json"), "groups": ["bedrooms"]}, tmp_path)
+    objs, arch, gt, rep = t["objects"], t["architecture"], t["ground_truth"], t["ingest_report"]
+    assert sorted(objs.category) == ["bed", "desk_lamp", "pillow", "side_table"]
+    reasons = dict(zip(rep.reason, rep["count"]))
+    assert reasons["part folded into its furniture"] == 1 and reasons["stored inside a drawer or cabinet"] == 1
+    assert reasons["wall-mounted"] == 1
+    assert arch[arch.kind == "window"].wall_id.tolist() == ["wall_1"]  # the x = 4 wall
+    cat = dict(zip(objs.object_id, objs.category))
+    assert {(cat[a], cat[b]) for a, b in zip(gt.anchor_id, gt.target_id)} == {("side_table", "desk_lamp"), ("bed", "pillow")}
+    bed = objs[objs.category == "bed"].iloc[0]  # against the y = 0 wall: faces +y
+    assert math.cos(bed.yaw) == pytest.approx(1.0) and 2 * bed.hy == pytest.approx(2.0)
+
+
+@pytest.mark.realdata
+def test_ithor_real_rooms_from_the_wheel(tmp_path):
+    pytest.importorskip("procthor", reason="the procthor wheel ships the AI2-THOR rooms")
+    t = run_ingest("ithor", {}, tmp_path)
+    assert len(t["rooms"]) == 120 and Counter(t["rooms"].room_type) == {"bedroom": 30, "living": 30, "kitchen": 30, "bathroom": 30}
+    assert len(t["ground_truth"]) > 1000
+
+
+# ----------------------------------------------------------------------------------------------- SUNCG
+def test_suncg_fixture_with_room_files(tmp_path):
+    t = run_ingest("suncg", {"houses": str(FIX / "suncg/house"), "room_folder": str(FIX / "suncg/room")}, tmp_path)
+    rooms, objs, rep = t["rooms"], t["objects"], t["ingest_report"]
+    assert rooms.room_type.tolist() == ["bedroom"] and rooms.extent_x[0] == pytest.approx(4.0)
+    assert sorted(objs.category) == ["bed_1", "lamp_1"]
+    bed = objs[objs.category == "bed_1"].iloc[0]
+    assert (bed.cx, bed.cy) == pytest.approx((2.0, -1.0)) and 2 * bed.hy == pytest.approx(2.0)
+    assert dict(zip(rep.reason, rep["count"]))["nodeIndices points past the level's nodes"] == 1
+
+
+def test_suncg_without_room_files_names_the_missing_file(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"fr_0rm_0f\.obj not found"):
+        run_ingest("suncg", {"houses": str(FIX / "suncg/house")}, tmp_path)
+
+
+@pytest.mark.realdata
+def test_suncg_real_sample_reports_the_missing_architecture(tmp_path):
+    sample = shared_data("suncg-sample")
+    with pytest.raises(FileNotFoundError, match=r"00e2eed27fb6b5c911624902888039ee/fr_0rm_0f\.obj not found"):
+        run_ingest("suncg", {"houses": str(sample / "house.json")}, tmp_path)
