@@ -63,7 +63,36 @@ def run(workdir: Path, rooms_wanted: int, python_rooms: int) -> dict:
     dt = time.perf_counter() - t
     result["python"] = {"rooms": len(subset), "seconds": round(dt, 3), "rooms_per_s": round(len(subset) / dt, 3),
                         "rays_per_s": round(rays / dt), "slowdown_vs_embree_same_rooms": round(dt / t_fast, 1)}
+    result["ray_kernel"] = kernel(inputs[0], models, ex, embree, slow)
     return result
+
+
+def kernel(room, models, ex, embree, slow, rays: int = 20000) -> dict:
+    """Rays/s of the two backends alone: the first hits of the same random horizontal and downward rays
+    against the same room scene (object meshes + plan prisms)."""
+    import numpy as np
+
+    from pipeline.extraction import PLAN_Z
+    from pipeline.geometry.meshes import combine, transform
+
+    parts = [(transform(models[m][0], p[0:3], p[3], p[4:7]), models[m][1]) for m, p in zip(room.model_ids, room.poses)]
+    v, f = combine(parts)
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices=v, faces=f, process=False)
+    rng = np.random.default_rng(0)
+    lo, hi = room.outline.min(axis=0), room.outline.max(axis=0)
+    origins = np.column_stack([rng.uniform(lo[0], hi[0], rays), rng.uniform(lo[1], hi[1], rays), rng.uniform(0.05, 1.5, rays)])
+    dirs = rng.normal(size=(rays, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    out = {"triangles": int(len(f)), "rays": rays}
+    for name, cls in (("embree", embree), ("python", slow)):
+        n = rays if name == "embree" else rays // 20
+        t = time.perf_counter()
+        cls(mesh).intersects_first(ray_origins=origins[:n], ray_directions=dirs[:n])
+        out[f"{name}_rays_per_s"] = round(n / (time.perf_counter() - t))
+    out["ratio"] = round(out["embree_rays_per_s"] / out["python_rays_per_s"], 1)
+    return out
 
 
 def main() -> None:

@@ -4,6 +4,6 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-for script in ("corpus.py", "extraction.py", "refine.py"):
+for script in ("corpus.py", "extraction.py", "refine.py", "front3d.py"):
     print(f"== {script}", flush=True)
     subprocess.run([sys.executable, str(HERE / script)], check=True)
