@@ -31,6 +31,17 @@ def _fail(message: str) -> None:
     raise typer.Exit(code=2)
 
 
+def _summary(values: dict, skip: tuple[str, ...] = ()) -> None:
+    """One line of key=value pairs: what a stage did."""
+    typer.echo(" ".join(f"{k}={v}" for k, v in values.items() if k not in skip))
+
+
+def _metrics(values: dict) -> None:
+    """One 'key: value' line per metric."""
+    for key, value in values.items():
+        typer.echo(f"{key}: {value}")
+
+
 def _guard(fn, *args, **kwargs):
     """Run a stage; known input errors become a one-line message and exit code 2."""
     from .tables import TableError
@@ -55,7 +66,7 @@ def ingest(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = Json
 
     cfg = _config(config, config_json)
     counts = _guard(stage.run, cfg, out)
-    typer.echo(" ".join(f"{k}={v}" for k, v in counts.items()))
+    _summary(counts)
 
 
 @app.command("filter")
@@ -95,7 +106,7 @@ def extract(shard: int = typer.Option(..., help="shard index"), config: Optional
 
     cfg = _config(config, config_json)
     summary = _guard(stage.run, cfg, shard, ingest_dir, filter_dir, out, symmetry_path)
-    typer.echo(" ".join(f"{k}={v}" for k, v in summary.items()))
+    _summary(summary)
 
 
 @app.command()
@@ -108,8 +119,7 @@ def score(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonO
 
     cfg = _config(config, config_json)
     metrics = _guard(stage.run, cfg, ingest_dir, raw_dir, out)
-    for key, value in metrics.items():
-        typer.echo(f"{key}: {value}")
+    _metrics(metrics)
 
 
 @app.command("graph-stats")
@@ -121,7 +131,7 @@ def graph_stats(config: Optional[Path] = ConfigOpt, config_json: Optional[str] =
 
     cfg = _config(config, config_json)
     summary = _guard(stage.run_statistics, cfg, raw_dir, out)
-    typer.echo(" ".join(f"{k}={v}" for k, v in summary.items()))
+    _summary(summary)
 
 
 @app.command()
@@ -135,7 +145,7 @@ def refine(shard: int = typer.Option(..., help="shard index"), config: Optional[
 
     cfg = _config(config, config_json)
     summary = _guard(stage.run_refine, cfg, shard, raw_dir, stats_dir, out)
-    typer.echo(" ".join(f"{k}={v}" for k, v in summary.items() if k != "cyclic_room_ids"))
+    _summary(summary, skip=("cyclic_room_ids",))
 
 
 @app.command("gather-graphs")
@@ -147,7 +157,7 @@ def gather_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str]
 
     cfg = _config(config, config_json)
     counts = _guard(stage.run_gather, cfg, final_dir, out)
-    typer.echo(" ".join(f"{k}={v}" for k, v in counts.items()))
+    _summary(counts)
 
 
 @app.command("score-graphs")
@@ -160,8 +170,7 @@ def score_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str] 
 
     cfg = _config(config, config_json)
     metrics = _guard(stage.run_superstructures, cfg, ingest_dir, graph_dir, out)
-    for key, value in metrics.items():
-        typer.echo(f"{key}: {value}")
+    _metrics(metrics)
 
 
 @app.command()
