@@ -2,8 +2,8 @@
 canonical tables, with ``parentReceptacles`` kept as ground-truth support parents.
 
 Unity is left-handed with Y up; the project is right-handed with Z up: ``(x, y, z) -> (x, z, y)``.
-Decisions (docs/departures.md): parts of furniture (drawers, cabinet doors, burners, knobs, faucets,
-basins) are folded into the furniture that holds them; things stored inside drawers and cabinets are
+Decisions (docs/departures.md): parts of furniture (drawers, cabinet doors, shelves, burners, knobs,
+faucets, basins) are folded into the furniture whose box holds them (else their receptacle); things stored inside drawers and cabinets are
 dropped (not visible, nothing to place); wall-mounted things are dropped; windows become architecture;
 an object's front is the side facing away from the nearest wall when it stands within 0.3 m of one,
 else the direction its rotation gives. Boxes come from the oriented corners where present.
@@ -93,11 +93,13 @@ def parse_room(group: str, index: int, objects: list[dict], cfg: dict, report: C
             return None
         if o["objectType"] not in PARTS:
             return oid
+        if holder.get(oid) is not None:  # a part belongs to the furniture whose box holds it (a basin: its sink)
+            return holder[oid]
         for p in o.get("parentReceptacles") or []:
             r = owner(p, depth + 1)
             if r is not None:
                 return r
-        return holder.get(oid)  # a fixed part: the smallest furniture box around it
+        return None
 
     windows = 0
     rows, gt, models = [], [], []

@@ -66,7 +66,8 @@ def choose_parents(obj: np.ndarray, hit_owner: np.ndarray, hit_dist: np.ndarray,
 
 
 def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volume: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For each point, the smallest box (other than ``own``) that contains it; -1 where none.
+    """For each point, the box (other than ``own``) that contains it with its top nearest above the point
+    (the surface it most likely rests on; ties to the smaller box); -1 where none.
 
     ``points (k, 3)``, ``boxes (n, 7)``, ``own (k,)`` box index to ignore per point. Returns the box index and
     a (k, n) containment mask.
@@ -80,9 +81,10 @@ def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volum
     ly = -rel[..., 0] * s + rel[..., 1] * c
     inside = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (np.abs(points[:, None, 2] - b[:, 2]) <= b[:, 5])
     inside[np.arange(len(points)), own] = False
-    vol = np.where(inside, volume[None, :], np.inf)
-    best = np.argmin(vol, axis=1)
-    return np.where(np.isfinite(vol[np.arange(len(points)), best]), best, -1), inside
+    top = b[:, 2] + b[:, 5]
+    score = np.where(inside, (top[None, :] - points[:, None, 2]) + 1e-6 * volume[None, :] / max(volume.max(), 1e-12), np.inf)
+    best = np.argmin(score, axis=1)
+    return np.where(np.isfinite(score[np.arange(len(points)), best]), best, -1), inside
 
 
 def break_support_cycles(parent: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
