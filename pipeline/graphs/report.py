@@ -94,7 +94,7 @@ def write_report(report: dict[str, pd.DataFrame], out_dir: Path) -> list[Path]:
     ax1.set_ylabel("edges per node")
     ax1.legend()
     pivot = pr.pivot_table(index="room_type", columns="rule", values="share_of_raw", fill_value=0.0)
-    pivot.plot(kind="bar", stacked=True, ax=ax2, legend=False)
+    pivot.plot(kind="bar", stacked=True, ax=ax2, legend=False, colormap="tab20")
     ax2.set_ylabel("share of raw object edges")
     ax2.legend(fontsize=7, bbox_to_anchor=(1.0, 1.0), loc="upper left")
     fig.tight_layout()
