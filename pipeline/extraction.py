@@ -149,6 +149,11 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) 
         first_dist[miss] = np.where(owner_in >= 0, 0.0, first_dist[miss])
     footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
     parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
+    if sc["inside_box_contact"] and len(raised):  # raised, nothing below: held from around (hung in a slab)?
+        loose = raised[parent[raised] < 0]
+        held = relations.holding_box(b, loose)
+        parent[loose] = np.where(held >= 0, held, parent[loose])
+        area[loose] = np.where(held >= 0, footprint[loose], area[loose])
     parent, cycles = relations.break_support_cycles(parent, footprint)
     area[parent < 0] = 0.0
     g.support_cycles = len(cycles)

@@ -168,3 +168,17 @@ def test_overlapping_meshes_stack_on_the_larger_supporting_surface():
     r.add("box", "books", (0.4, 0.3, 0.1), (2.0, 1.0), z=0.752)  # 0.3 over the desk, 0.1 over the shelf
     g = r.extract()
     assert {n["node_id"]: n["parent_id"] for n in g.nodes}["box"] == "desk"
+
+
+def test_box_contact_rules_for_box_only_sources():
+    r = Room([[0, 0], [5, 0], [5, 4], [0, 4]])
+    r.add("bed", "bed", (1.6, 2.0, 1.0), (2.5, 1.01))  # a box up to its headboard's height
+    r.add("pillow", "pillow", (0.5, 0.3, 0.15), (2.5, 0.5), z=0.6)  # sunk 0.4 m into the bed's box
+    r.add("slab", "counter_top", (2.0, 0.6, 0.02), (1.5, 3.6), z=0.9)
+    r.add("sink", "sink", (0.5, 0.4, 0.25), (1.5, 3.6), z=0.67)  # hangs through the slab: nothing below it
+    parents = {n["node_id"]: n["parent_id"] for n in r.extract().nodes}
+    assert parents["pillow"] == "bed" and parents["sink"] == "slab" and parents["slab"] is None
+    cfg = default_config()
+    cfg["extract"]["support"]["inside_box_contact"] = False
+    parents = {n["node_id"]: n["parent_id"] for n in r.extract(cfg=cfg["extract"]).nodes}
+    assert parents["pillow"] is None and parents["sink"] is None

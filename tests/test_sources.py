@@ -131,11 +131,21 @@ def test_ithor_fixture_room(tmp_path):
 
 
 @pytest.mark.realdata
-def test_ithor_real_rooms_from_the_wheel(tmp_path):
+@pytest.mark.slow
+def test_ithor_real_rooms_support_parents_agree(tmp_path):
     pytest.importorskip("procthor", reason="the procthor wheel ships the AI2-THOR rooms")
-    t = run_ingest("ithor", {}, tmp_path)
-    assert len(t["rooms"]) == 120 and Counter(t["rooms"].room_type) == {"bedroom": 30, "living": 30, "kitchen": 30, "bathroom": 30}
-    assert len(t["ground_truth"]) > 1000
+    from pipeline.stages import extract, filter as filter_stage, score, symmetry
+
+    cfg = config.load(ROOT / "config/ithor.yaml", json.dumps({"shards": 1, "extract": {"symmetry": {"detect": False}}}))
+    ingest.run(cfg, tmp_path / "ingest")
+    rooms = pd.read_parquet(tmp_path / "ingest/rooms.parquet")
+    assert len(rooms) == 120 and Counter(rooms.room_type) == {"bedroom": 30, "living": 30, "kitchen": 30, "bathroom": 30}
+    filter_stage.run(cfg, tmp_path / "ingest", tmp_path / "filter")
+    symmetry.run(cfg, tmp_path / "ingest", tmp_path / "symmetry")
+    extract.run(cfg, 0, tmp_path / "ingest", tmp_path / "filter", tmp_path / "raw", tmp_path / "symmetry/symmetry.parquet")
+    metrics = score.run(cfg, tmp_path / "ingest", tmp_path / "raw", tmp_path / "m.json")
+    assert metrics["supported_objects"] > 1500
+    assert metrics["support_parent_recall"] >= 0.95
 
 
 # ----------------------------------------------------------------------------------------------- SUNCG

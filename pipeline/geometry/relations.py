@@ -87,6 +87,25 @@ def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volum
     return np.where(np.isfinite(score[np.arange(len(points)), best]), best, -1), inside
 
 
+def holding_box(boxes: np.ndarray, candidates: np.ndarray) -> np.ndarray:
+    """For each candidate box, the box that holds it from around: its footprint contains the candidate's
+    centre and its vertical span starts above the candidate's bottom and overlaps it (a sink hung in a
+    counter slab, a ladle through a holder). The lowest such box wins; -1 where none."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    out = np.full(len(candidates), -1, dtype=np.int64)
+    for i, k in enumerate(candidates):
+        rel = b[k, :2] - b[:, :2]
+        c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
+        lx, ly = rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c
+        bottom, top = b[:, 2] - b[:, 5], b[:, 2] + b[:, 5]
+        k_bottom, k_top = b[k, 2] - b[k, 5], b[k, 2] + b[k, 5]
+        ok = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (bottom > k_bottom) & (bottom < k_top)
+        ok[k] = False
+        if ok.any():
+            out[i] = int(np.flatnonzero(ok)[np.argmin(bottom[ok])])
+    return out
+
+
 def break_support_cycles(parent: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
     """Un-parent the largest object of every support cycle. Returns the new parents and the cycles found."""
     parent = parent.copy()

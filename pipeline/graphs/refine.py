@@ -278,7 +278,7 @@ def _nearest_wall(idx: dict, target: str) -> str:
 
 
 # weakest first: which kept edge a cycle gives up (superstructure and support edges never)
-BREAKABLE = ("frequent", "connectivity", "hub_inherited", "chain_inherited", "keep_unique_front_proximal",
+BREAKABLE = ("frequent", "no_pruning", "connectivity", "hub_inherited", "chain_inherited", "keep_unique_front_proximal",
              "keep_same_category_adjacent")
 
 
