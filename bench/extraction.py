@@ -72,7 +72,6 @@ def kernel(room, models, ex, embree, slow, rays: int = 20000) -> dict:
     against the same room scene (object meshes + plan prisms)."""
     import numpy as np
 
-    from pipeline.extraction import PLAN_Z
     from pipeline.geometry.meshes import combine, transform
 
     parts = [(transform(models[m][0], p[0:3], p[3], p[4:7]), models[m][1]) for m, p in zip(room.model_ids, room.poses)]

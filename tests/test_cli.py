@@ -7,7 +7,6 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from pipeline import tables
-from conftest import ROOT
 
 PLANIT = str(Path(sys.executable).parent / "planit")
 

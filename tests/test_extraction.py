@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from pipeline.corpus import catalog
-from pipeline.geometry import meshes, relations
+from pipeline.geometry import relations
 from conftest import Room, default_config, edge
 
 DIST = default_config()["extract"]["distance"]

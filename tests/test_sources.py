@@ -12,7 +12,7 @@ import pytest
 import shapely
 
 from pipeline import config
-from pipeline.corpus import front3d, ithor, suncg
+from pipeline.corpus import front3d
 from pipeline.stages import ingest
 from conftest import ROOT, shared_data
 

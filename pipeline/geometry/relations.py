@@ -97,7 +97,7 @@ def holding_box(boxes: np.ndarray, candidates: np.ndarray) -> np.ndarray:
         rel = b[k, :2] - b[:, :2]
         c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
         lx, ly = rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c
-        bottom, top = b[:, 2] - b[:, 5], b[:, 2] + b[:, 5]
+        bottom = b[:, 2] - b[:, 5]
         k_bottom, k_top = b[k, 2] - b[k, 5], b[k, 2] + b[k, 5]
         ok = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (bottom > k_bottom) & (bottom < k_top)
         ok[k] = False

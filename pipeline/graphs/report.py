@@ -27,7 +27,7 @@ def _con(graph_dir: Path) -> duckdb.DuckDBPyConnection:
 
 def graph_report(graph_dir: Path) -> dict[str, pd.DataFrame]:
     con = _con(graph_dir)
-    table1 = con.execute(f"""
+    table1 = con.execute("""
         WITH n AS (SELECT room_id, CAST(room_type AS VARCHAR) room_type, count(*) nodes,
                           count(*) FILTER (WHERE kind = 'object') non_wall_nodes FROM nodes GROUP BY ALL),
              e AS (SELECT e.room_id,

@@ -46,7 +46,7 @@ def ingest_procedural(config: dict) -> dict[str, pa.Table]:
 
 
 def _report_rows(source: str, report: Counter) -> list[dict]:
-    return [{"source": source, "item": reason if kind != "object" or status != "kept" else reason, "kind": kind,
+    return [{"source": source, "item": reason, "kind": kind,
              "status": status, "reason": reason, "count": n} for (kind, status, reason), n in sorted(report.items())]
 
 

@@ -6,7 +6,6 @@ import logging
 from pathlib import Path
 
 import numpy as np
-import pyarrow as pa
 
 from .. import tables
 from ..config import config_hash
