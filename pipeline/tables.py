@@ -244,7 +244,6 @@ def conform(name: str, table: pa.Table) -> pa.Table:
 def write(path: str | Path, name: str, table: pa.Table, extra: dict | None = None) -> Path:
     """Write ``table`` as schema ``name`` to ``path`` atomically (temp file in the same folder, then rename)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     table = conform(name, table)
     meta = {
         "pipeline.schema": f"{name}/v1",
@@ -254,16 +253,33 @@ def write(path: str | Path, name: str, table: pa.Table, extra: dict | None = Non
     for key, value in (extra or {}).items():
         meta[f"pipeline.{key}"] = value if isinstance(value, str) else json.dumps(value)
     table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
+    return _atomic(path, lambda tmp: pq.write_table(table, tmp, compression="zstd"))
+
+
+def _atomic(path: Path, write_to) -> Path:
+    """Call ``write_to(temporary path)`` in ``path``'s folder, then rename onto ``path``; nothing is left on failure."""
+    path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
-        pq.write_table(table, tmp, compression="zstd")
+        write_to(tmp)
         os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; shared (cluster) filesystems need the usual mode
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def write_json(path: str | Path, value) -> Path:
+    """A JSON side file (summaries, metrics), written atomically."""
+    text = json.dumps(value, indent=2)
+    return _atomic(Path(path), lambda tmp: Path(tmp).write_text(text))
+
+
+def write_tsv(path: str | Path, frame) -> Path:
+    """A tab-separated side file from a DataFrame, written atomically."""
+    return _atomic(Path(path), lambda tmp: frame.to_csv(tmp, sep="\t", index=False))
 
 
 def read(path: str | Path, name: str | None = None, filters=None) -> pa.Table:

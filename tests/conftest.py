@@ -85,20 +85,11 @@ def default_config() -> dict:
     return config_mod.validate({})
 
 
-def edges_df(graph) -> pd.DataFrame:
-    return pd.DataFrame(graph.edges)
-
-
 def edge(graph, src, dst, edge_type="spatial"):
     """The one edge src -> dst of a type, or None."""
     e = [x for x in graph.edges if x["source"] == src and x["target"] == dst and x["edge_type"] == edge_type]
     assert len(e) <= 1
     return e[0] if e else None
-
-
-@pytest.fixture
-def rect_room():
-    return Room([[0, 0], [5, 0], [5, 4], [0, 4]])
 
 
 def shared_data(sub: str) -> Path:

@@ -23,7 +23,7 @@ from ..geometry import meshes as M
 
 GROUPS = {"bedrooms": "bedroom", "living_rooms": "living", "kitchens": "kitchen", "bathrooms": "bathroom"}
 PARTS = {"Drawer", "Cabinet", "Shelf", "StoveBurner", "StoveKnob", "Faucet", "SinkBasin", "BathtubBasin", "ShowerHead"}
-CONTAINERS = {"Drawer", "Cabinet", "Safe", "Fridge", "Microwave", "Box"}
+HIDDEN_IN = {"Drawer", "Cabinet"}  # things inside these are stored away, not placed
 WALL_MOUNTED = {"LightSwitch", "Painting", "Poster", "Mirror", "Blinds", "Curtains", "ShowerDoor", "ShowerGlass",
                 "ShowerCurtain", "TowelHolder", "HandTowelHolder", "ToiletPaperHanger", "Window", "Floor"}
 FLOOR_STANDING = 0.01  # m: an object whose bottom is this close to the floor stands on it
@@ -120,8 +120,7 @@ def parse_room(group: str, index: int, objects: list[dict], cfg: dict, report: C
             report[("object", "dropped", "part folded into its furniture")] += 1
             continue
         parents = o.get("parentReceptacles") or []
-        if any(by_id.get(p, {}).get("objectType") in CONTAINERS and by_id[p]["objectType"] in ("Drawer", "Cabinet")
-               for p in parents):
+        if any(by_id.get(p, {}).get("objectType") in HIDDEN_IN for p in parents):
             report[("object", "dropped", "stored inside a drawer or cabinet")] += 1
             continue
         corners = _corners(o)

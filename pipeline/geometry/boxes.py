@@ -32,12 +32,6 @@ def diagonal_2d(hx, hy) -> np.ndarray:
     return 2.0 * np.hypot(hx, hy)
 
 
-def project(corners: np.ndarray, origin: np.ndarray, axis: np.ndarray) -> np.ndarray:
-    """``(n, 2)`` interval [min, max] of each corner set projected on ``axis`` from ``origin``."""
-    t = (corners - origin) @ axis
-    return np.stack([t.min(axis=-1), t.max(axis=-1)], -1)
-
-
 def _axes(yaw: np.ndarray) -> np.ndarray:
     r = rotation(yaw)  # (n, 2, 2): columns are local x and y in world
     return np.stack([r[..., 0], r[..., 1]], 1)  # (n, 2 axes, 2)

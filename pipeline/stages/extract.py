@@ -1,7 +1,6 @@
 """Extraction stage: one shard of filtered rooms -> raw relation-graph tables ``nodes-<shard>`` / ``edges-<shard>``."""
 from __future__ import annotations
 
-import json
 import logging
 import time
 from pathlib import Path
@@ -77,7 +76,5 @@ def run(config: dict, shard: int, ingest_dir: str | Path, filter_dir: str | Path
     tables.write(out_dir / f"edges-{shard}.parquet", "edges", tables.from_rows("edges", edges), extra)
     summary = {"shard": shard, "rooms": len(rooms), "nodes": len(nodes), "edges": len(edges), "rays": rays,
                "support_cycles": cycles, "seconds": round(seconds, 3), "skipped": skipped, "backend": cfg["backend"]}
-    tmp = out_dir / f".summary-{shard}.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=1))
-    tmp.replace(out_dir / f"summary-{shard}.json")
+    tables.write_json(out_dir / f"summary-{shard}.json", summary)
     return {k: v for k, v in summary.items() if k != "skipped"} | {"skipped": len(skipped)}

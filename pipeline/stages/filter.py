@@ -27,9 +27,7 @@ def run(config: dict, ingest_dir: str | Path, out_dir: str | Path) -> pd.DataFra
     tables.write(out_dir / "report.parquet", "filter_report", pa.Table.from_pandas(report, preserve_index=False), extra)
     tables.write(out_dir / "rooms.parquet", "rooms", pa.Table.from_pandas(kept, preserve_index=False), extra)
     counts = rule_counts(report)
-    tmp = out_dir / ".rule_counts.tsv.tmp"
-    counts.to_csv(tmp, sep="\t", index=False)
-    tmp.replace(out_dir / "rule_counts.tsv")
+    tables.write_tsv(out_dir / "rule_counts.tsv", counts)
     log.info("kept %d of %d rooms", len(kept), len(rooms))
     for row in counts.itertuples(index=False):
         log.info("  %-9s %-18s %6d", row.room_type, row.outcome, row.rooms)

@@ -1,7 +1,6 @@
 """Graph stages: dataset statistics (gather), per-shard refinement, gathered final tables, and scores."""
 from __future__ import annotations
 
-import json
 import logging
 from pathlib import Path
 
@@ -103,9 +102,7 @@ def run_refine(config: dict, shard: int, raw_dir: Path, stats_dir: Path, out_dir
     summary = {"shard": shard, "rooms": rooms, "edges": len(out_edges),
                "kept": sum(e["status"] == "kept" for e in out_edges), "repaired": repaired,
                "cyclic_rooms": len(cyclic), "cyclic_room_ids": cyclic}
-    tmp = out_dir / f".summary-{shard}.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=1))
-    tmp.replace(out_dir / f"summary-{shard}.json")
+    tables.write_json(out_dir / f"summary-{shard}.json", summary)
     log.info("refined shard %d: %s", shard, {k: v for k, v in summary.items() if k != "cyclic_room_ids"})
     return summary
 

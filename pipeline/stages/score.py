@@ -1,7 +1,6 @@
 """Score stage: extracted raw graphs vs the source's ground truth, written to a metrics JSON each run."""
 from __future__ import annotations
 
-import json
 import logging
 from pathlib import Path
 
@@ -46,10 +45,6 @@ def run_superstructures(config: dict, ingest_dir: str | Path, graph_dir: str | P
 
 
 def _write(metrics: dict, out: str | Path) -> dict:
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(json.dumps(metrics, indent=2))
-    tmp.replace(out)
+    tables.write_json(out, metrics)
     log.info("scores: %s", metrics)
     return metrics

@@ -1,7 +1,6 @@
 """Symmetry stage: one functional symmetry type per model (config table first, else detected from the mesh)."""
 from __future__ import annotations
 
-import json
 import logging
 from pathlib import Path
 
@@ -47,8 +46,6 @@ def run(config: dict, ingest_dir: str | Path, out_dir: str | Path) -> dict:
     out_dir = Path(out_dir)
     tables.write(out_dir / "symmetry.parquet", "symmetry", tables.from_rows("symmetry", rows),
                  {"config_hash": config_hash(cfg)})
-    tmp = out_dir / ".agreement.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=2))
-    tmp.replace(out_dir / "agreement.json")
+    tables.write_json(out_dir / "agreement.json", summary)
     log.info("symmetry: %d models, detection agrees with the table on %s of %d", len(rows), summary["agreement"], len(both))
     return summary
