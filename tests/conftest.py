@@ -2,12 +2,14 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import settings
 
 from pipeline import config as config_mod
 from pipeline.extraction import extract_room
@@ -18,6 +20,12 @@ from pipeline.roomdata import room_inputs
 
 ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = ROOT.parent / "shared" / "data"
+
+# Property tests: the default profile is derandomized (every run tries the same 200 cases, so CI is
+# reproducible); HYPOTHESIS_PROFILE=deep searches 5,000 fresh random cases per property.
+settings.register_profile("default", max_examples=200, deadline=None, derandomize=True)
+settings.register_profile("deep", max_examples=5000, deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
 class Room:

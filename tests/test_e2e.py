@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
@@ -71,6 +72,17 @@ def test_contents_are_consistent(run_dir):
     for log in ["ingest/ingest.log", "filter_rooms/filter_rooms.log", "extract_graphs/0.log", "symmetry/symmetry.log",
                 "graph_statistics/graph_statistics.log", "refine_graphs/1.log"]:
         assert (run_dir / "logs" / log).stat().st_size > 0, log
+
+
+def test_statistics_do_not_depend_on_the_thread_count(run_dir):
+    # A cluster job gets one CPU, a laptop several: DuckDB float means must come out bit-identical.
+    from pipeline.graphs.statistics import relation_statistics
+    raw = run_dir / "results" / "graphs" / "raw"
+    nodes, edges = sorted(raw.glob("nodes-*.parquet")), sorted(raw.glob("edges-*.parquet"))
+    one, many = relation_statistics(nodes, edges, threads=1), relation_statistics(nodes, edges, threads=8)
+    assert len(one["category_sizes"]) > 10
+    for name in one:
+        pd.testing.assert_frame_equal(one[name], many[name], check_exact=True, obj=name)
 
 
 def test_second_run_has_nothing_to_do(run_dir):

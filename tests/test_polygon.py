@@ -1,5 +1,5 @@
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, strategies as st
 
 from pipeline.geometry.polygon import (extents, make_ccw, merge_collinear, outline_from_loop, polygon_segments,
                                        signed_area, wall_loop)
@@ -54,7 +54,6 @@ def star_polygons(draw):
     return np.column_stack([radii * np.cos(angles), radii * np.sin(angles)])
 
 
-@settings(max_examples=200, deadline=None)
 @given(poly=star_polygons(), seed=st.integers(0, 2**31 - 1), cut=st.floats(0.01, 0.5))
 def test_wall_loop_properties(poly, seed, cut):
     rng = np.random.default_rng(seed)

@@ -1,7 +1,7 @@
 """Graph refinement: superstructures on hand-built rooms, and properties on random graphs."""
 import networkx as nx
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, strategies as st
 
 from pipeline.graphs.refine import ARCHITECTURE_EDGES, Stats, refine_room
 from pipeline.graphs.superstructures import fits_symmetry
@@ -25,6 +25,19 @@ def bedroom_with_row(wardrobes: int) -> Room:
     for k in range(wardrobes):  # along wall_2 (y = 5), facing -y
         r.add(f"w{k}", "wardrobe", (0.9, 0.6, 2.0), (5.0 - 0.455 - k * 0.905, 4.697), yaw_deg=180)
     return r
+
+
+def _box_node(node_id, kind, category, **fields):
+    node = {"room_id": "r", "node_id": node_id, "kind": kind, "category": category,
+            "model_id": None if kind == "wall" else f"m_{category}", "symmetry": "none", "tier": 0 if kind == "wall" else 1,
+            "parent_id": None, "cx": 0.0, "cy": 0.0, "cz": 0.5, "hx": 1.0, "hy": 1.0, "hz": 0.5, "yaw": 0.0,
+            "length": None, "room_type": "bedroom"}
+    return node | fields
+
+
+def _edge(a, b, edge_type="spatial", direction="front"):
+    return {"room_id": "r", "source": a, "target": b, "edge_type": edge_type, "direction": direction,
+            "distance": "adjacent", "gap": 0.0}
 
 
 SYM = {"bed": "left-right", "nightstand": "left-right", "wardrobe": "left-right"}
@@ -62,6 +75,21 @@ def test_pruning_modes_and_audit_trail():
         assert (e["status"], e["rule"]) == ("kept", "connectivity") or e["status"] == "pruned", e
 
 
+def test_repair_never_revives_the_losing_half_of_a_double_edge():
+    # o0 -> o1 -> o2 is a chain, so o1 -> o0 loses the double edge; o0's only inbound edge is that loser.
+    # Reviving it would make the 2-cycle o0 <-> o1; the repair must fall back to a wall edge instead.
+    nodes = [_box_node(f"o{k}", "object", "a", cy=2.0 - k) for k in range(3)]
+    nodes += [_box_node(f"wall_{w}", "wall", "wall", cx=2.0, cy=2.0, length=4.0) for w in range(4)]
+    edges = [_edge("o0", "o1"), _edge("o1", "o0"), _edge("o1", "o2"), _edge("wall_0", "o1")]
+    edges += [_edge(f"wall_{w}", f"wall_{(w + 1) % 4}", "wall_adjacent", "right") for w in range(4)]
+    out = refine_room(nodes, edges, Stats(hub_patterns={"bedroom": set()}), CFG)
+    status = {(e["source"], e["target"]): (e["status"], e["rule"]) for e in out.edges}
+    assert status[("o0", "o1")] == ("kept", "keep_superstructure")
+    assert status[("o1", "o0")] == ("pruned", "double_edge")
+    assert [k for k, v in status.items() if k[1] == "o0" and v[1] == "connectivity_fallback"]
+    assert not out.cyclic
+
+
 @pytest.mark.parametrize("symmetry, dirs, count, ok", [
     ("left-right", {"left", "right"}, 2, True), ("left-right", {"left", "front"}, 2, False),
     ("radial", {"front"}, 3, True), ("radial", {"front"}, 1, False), ("rotational-2", {"front", "back"}, 2, True),
@@ -84,15 +112,11 @@ def random_graphs(draw):
     cats = draw(st.lists(st.sampled_from(["a", "b", "c"]), min_size=n, max_size=n))
     nodes = []
     for k in range(n):
-        nodes.append({"room_id": "r", "node_id": f"o{k}", "kind": "object", "category": cats[k], "model_id": f"m_{cats[k]}",
-                      "symmetry": draw(st.sampled_from(SYMS)), "tier": 1, "parent_id": None,
-                      "cx": draw(st.floats(0, 4)), "cy": draw(st.floats(0, 4)), "cz": 0.5,
-                      "hx": draw(st.floats(0.1, 1)), "hy": draw(st.floats(0.1, 1)), "hz": 0.5, "yaw": 0.0,
-                      "length": None, "room_type": "bedroom"})
+        nodes.append(_box_node(f"o{k}", "object", cats[k], symmetry=draw(st.sampled_from(SYMS)),
+                               cx=draw(st.floats(0, 4)), cy=draw(st.floats(0, 4)),
+                               hx=draw(st.floats(0.1, 1)), hy=draw(st.floats(0.1, 1))))
     for w in range(4):
-        nodes.append({"room_id": "r", "node_id": f"wall_{w}", "kind": "wall", "category": "wall", "model_id": None,
-                      "symmetry": "none", "tier": 0, "parent_id": None, "cx": 2.0, "cy": 2.0, "cz": 1.0, "hx": 2.0,
-                      "hy": 0.05, "hz": 1.0, "yaw": 0.0, "length": 4.0, "room_type": "bedroom"})
+        nodes.append(_box_node(f"wall_{w}", "wall", "wall", cx=2.0, cy=2.0, cz=1.0, hx=2.0, hy=0.05, hz=1.0, length=4.0))
     ids = [x["node_id"] for x in nodes]
     pairs = draw(st.lists(st.tuples(st.sampled_from(ids), st.sampled_from(ids[:n]), st.sampled_from(DIRS),
                                     st.sampled_from(DISTS), st.floats(0, 3)), max_size=25, unique_by=lambda p: (p[0], p[1])))
@@ -105,7 +129,6 @@ def random_graphs(draw):
     return nodes, edges, Stats(relfreq=relfreq, hub_patterns={"bedroom": {("a", "b"), ("b", "c")}})
 
 
-@settings(max_examples=150, deadline=None)
 @given(graph=random_graphs(), mode=st.sampled_from(["full", "half", "none"]))
 def test_refinement_properties(graph, mode):
     nodes, edges, stats = graph
@@ -113,11 +136,13 @@ def test_refinement_properties(graph, mode):
     # every raw edge is accounted for once, with a status and the rule that decided it
     raw = [e for e in out.edges if e["origin"] == "raw"]
     assert len(raw) == len(edges) and all(e["status"] in ("kept", "pruned") and e["rule"] for e in out.edges)
-    # keep rules are never overturned
+    # keep rules are never overturned; only the superstructure steps, which run before them (authors' order),
+    # may drop a wall's adjacent edge into a chain's middle
     for e in out.edges:
-        if e["edge_type"] in ARCHITECTURE_EDGES or e["group_id"] is not None or (
-                e["source"].startswith("wall") and e["distance"] == "adjacent" and e["origin"] == "raw"):
+        if e["edge_type"] in ARCHITECTURE_EDGES or e["group_id"] is not None:
             assert e["status"] == "kept", e
+        if e["source"].startswith("wall") and e["distance"] == "adjacent" and e["origin"] == "raw":
+            assert e["status"] == "kept" or e["rule"] == "chain_member_inbound", e
         if e["status"] == "pruned":
             assert not e["rule"].startswith("keep_"), e
     kept = [(e["source"], e["target"]) for e in out.edges if e["status"] == "kept"]

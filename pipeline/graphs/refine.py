@@ -207,7 +207,8 @@ def _repair_connectivity(edges: list[dict], idx: dict, cfg: dict) -> int:
 
     Tiers: adjacent and support edges only, then proximal, then distant; within a tier, paths that
     create no cycle first. Proximal edges may not run from a much smaller object to a larger one of
-    another category (unless from a wall). Objects still unreachable get a distant edge from the nearest wall.
+    another category (unless from a wall), and no edge whose reverse is kept may come back (that would undo
+    double-edge resolution). Objects still unreachable get a distant edge from the nearest wall.
     """
     cc = cfg["connectivity"]
     repaired = 0
@@ -255,6 +256,8 @@ def _cheapest_path(edges, idx, kept, reach, target, allowed, allow_cycles, cc) -
         a, b = idx[e["source"]], idx[e["target"]]
         if (kind == "proximal" and a["kind"] == "object" and a["category"] != b["category"]
                 and a["diag"] < cc["smaller_to_larger_ratio"] * b["diag"]):
+            continue
+        if kept.has_edge(e["target"], e["source"]):
             continue
         if not allow_cycles and (e["target"] in reach or nx.has_path(kept, e["target"], e["source"])):
             continue

@@ -12,11 +12,13 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from .. import duck
+
 ARCH = "('wall_adjacent', 'wall_opposite', 'opening')"
 
 
 def _con(graph_dir: Path) -> duckdb.DuckDBPyConnection:
-    con = duckdb.connect()
+    con = duck.connect()
     for name in ("nodes", "edges", "superstructures"):
         path = Path(graph_dir) / f"{name}.parquet"
         if not path.exists():
@@ -39,8 +41,8 @@ def graph_report(graph_dir: Path) -> dict[str, pd.DataFrame]:
              s AS (SELECT room_id, count(DISTINCT group_id) FILTER (WHERE kind = 'hub') hubs,
                           count(DISTINCT group_id) FILTER (WHERE kind = 'chain') chains FROM superstructures GROUP BY ALL)
         SELECT room_type, count(*) rooms, avg(nodes) nodes, avg(non_wall_nodes) non_wall_nodes, avg(edges) edges,
-               avg(non_wall_edges) non_wall_edges, avg(raw_edges / nodes) edges_per_node_raw,
-               avg(edges / nodes) edges_per_node_final, sum(coalesce(hubs, 0)) hubs, sum(coalesce(chains, 0)) chains
+               avg(non_wall_edges) non_wall_edges, stable_avg(raw_edges / nodes) edges_per_node_raw,
+               stable_avg(edges / nodes) edges_per_node_final, sum(coalesce(hubs, 0)) hubs, sum(coalesce(chains, 0)) chains
         FROM n JOIN e USING (room_id) LEFT JOIN s USING (room_id) GROUP BY ALL ORDER BY room_type""").df()
     pruning = con.execute(f"""
         WITH c AS (SELECT CAST(room_type AS VARCHAR) room_type, CAST(rule AS VARCHAR) rule,

@@ -4,8 +4,9 @@ from __future__ import annotations
 from collections import Counter
 from pathlib import Path
 
-import duckdb
 import pandas as pd
+
+from .. import duck
 
 from .refine import node_index
 from .superstructures import find_chains, hub_candidates
@@ -15,9 +16,11 @@ def _files(paths: list[Path]) -> str:
     return "[" + ", ".join(f"'{p.as_posix()}'" for p in paths) + "]"
 
 
-def relation_statistics(node_files: list[Path], edge_files: list[Path]) -> dict[str, pd.DataFrame]:
-    """Co-occurrence, relationship frequencies and category sizes per room type."""
-    con = duckdb.connect()
+def relation_statistics(node_files: list[Path], edge_files: list[Path],
+                        threads: int | None = None) -> dict[str, pd.DataFrame]:
+    """Co-occurrence, relationship frequencies and category sizes per room type (identical for any
+    ``threads``)."""
+    con = duck.connect(threads)
     con.execute(f"CREATE VIEW nodes AS SELECT * FROM read_parquet({_files(node_files)})")
     con.execute(f"CREATE VIEW edges AS SELECT * FROM read_parquet({_files(edge_files)})")
     con.execute("""
@@ -46,7 +49,7 @@ def relation_statistics(node_files: list[Path], edge_files: list[Path]) -> dict[
         FROM rel JOIN co USING (room_type, cat_a, cat_b) ORDER BY ALL""").df()
     sizes = con.execute("""
         SELECT CAST(room_type AS VARCHAR) room_type, CAST(category AS VARCHAR) category, count(*) instances,
-               avg(4 * hx * hy) mean_area, avg(2 * sqrt(hx * hx + hy * hy)) mean_diag
+               stable_avg(4 * hx * hy) mean_area, stable_avg(2 * sqrt(hx * hx + hy * hy)) mean_diag
         FROM nodes WHERE kind = 'object' GROUP BY ALL ORDER BY ALL""").df()
     return {"cooccurrence": cooccurrence, "relations": relations, "category_sizes": sizes}
 
