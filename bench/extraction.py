@@ -7,21 +7,18 @@ Builds the default corpus (config/config.yaml) under --workdir if it is not ther
 """
 from __future__ import annotations
 
-import argparse
-import json
 import platform
 import time
 import warnings
 from pathlib import Path
 
-from pipeline import config as config_mod
 from pipeline.extraction import extract_room
 from pipeline.geometry.raycast import intersector_class
 from pipeline.roomdata import room_inputs
 from pipeline.stages import filter as filter_stage, ingest, symmetry
 from pipeline.stages.extract import load_shard
 
-ROOT = Path(__file__).resolve().parents[1]
+from common import arguments, default_config, report
 
 
 def corpus(workdir: Path, cfg: dict) -> None:
@@ -33,7 +30,7 @@ def corpus(workdir: Path, cfg: dict) -> None:
 
 
 def run(workdir: Path, rooms_wanted: int, python_rooms: int) -> dict:
-    cfg = config_mod.load(ROOT / "config" / "config.yaml", json.dumps({"shards": 1}))
+    cfg = default_config()
     corpus(workdir, cfg)
     rooms, arch, objs, models = load_shard(workdir / "ingest", workdir / "filter", 0)
     inputs = list(room_inputs(rooms, arch, objs))[:rooms_wanted]
@@ -95,15 +92,12 @@ def kernel(room, models, ex, embree, slow, rays: int = 20000) -> dict:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--workdir", type=Path, default=ROOT / "bench" / "out")
+    ap = arguments(__doc__)
     ap.add_argument("--rooms", type=int, default=1000)
     ap.add_argument("--python-rooms", type=int, default=4)
     args = ap.parse_args()
     result = run(args.workdir, args.rooms, args.python_rooms)
-    args.workdir.mkdir(parents=True, exist_ok=True)
-    (args.workdir / "extraction.json").write_text(json.dumps(result, indent=2))
-    print(json.dumps(result, indent=2))
+    report(result, args.workdir, "extraction")
 
 
 if __name__ == "__main__":

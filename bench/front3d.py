@@ -5,24 +5,24 @@ cache and with a warm one (parsed OBJ meshes are cached as .npz, so a re-run doe
 """
 from __future__ import annotations
 
-import argparse
-import json
 import shutil
+import statistics
 import time
 from pathlib import Path
 
 from pipeline import config as config_mod
 from pipeline.stages import ingest
 
-ROOT = Path(__file__).resolve().parents[1]
+from common import OUT, ROOT, arguments, report
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = arguments(__doc__, OUT / "front3d")
     ap.add_argument("--sample", type=Path, default=ROOT.parent / "shared" / "data" / "3d-front-sample")
-    ap.add_argument("--workdir", type=Path, default=ROOT / "bench" / "out" / "front3d")
-    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--repeat", type=int, default=5, help="runs: the first with an empty cache, the rest warm (>= 2)")
     args = ap.parse_args()
+    if args.repeat < 2:
+        ap.error("--repeat must be at least 2: one cold run, then warm ones")
     cache = args.workdir / "cache"
     shutil.rmtree(cache, ignore_errors=True)
     cfg = config_mod.validate({"source": "front3d", "front3d": {"houses": str(args.sample / "houses"),
@@ -32,12 +32,11 @@ def main() -> None:
         t = time.perf_counter()
         counts = ingest.run(cfg, args.workdir / "ingest")
         times.append(time.perf_counter() - t)
+    warm = statistics.median(times[1:])
     result = {"houses": len(list((args.sample / "houses").glob("*.json"))), "rooms": counts["rooms"],
               "objects": counts["objects"], "first_run_seconds": round(times[0], 2),
-              "warm_runs_median_seconds": round(sorted(times[1:])[len(times[1:]) // 2], 2),
-              "rooms_per_s_warm": round(counts["rooms"] / sorted(times[1:])[len(times[1:]) // 2], 1)}
-    (args.workdir / "front3d.json").write_text(json.dumps(result, indent=2))
-    print(json.dumps(result, indent=2))
+              "warm_runs_median_seconds": round(warm, 2), "rooms_per_s_warm": round(counts["rooms"] / warm, 1)}
+    report(result, args.workdir, "front3d")
 
 
 if __name__ == "__main__":

@@ -5,23 +5,18 @@ rooms/s for one shard, single process.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import time
-from pathlib import Path
 
-from pipeline import config as config_mod
 from pipeline.stages import extract, graphs
 
-ROOT = Path(__file__).resolve().parents[1]
+from common import arguments, default_config, report
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--workdir", type=Path, default=ROOT / "bench" / "out")
+    ap = arguments(__doc__)
     args = ap.parse_args()
     w = args.workdir
-    cfg = config_mod.load(ROOT / "config" / "config.yaml", json.dumps({"shards": 1}))
+    cfg = default_config()
     t = time.perf_counter()
     ex = extract.run(cfg, 0, w / "ingest", w / "filter", w / "raw1", w / "symmetry" / "symmetry.parquet")
     t_extract = time.perf_counter() - t
@@ -36,8 +31,7 @@ def main() -> None:
               "graph_statistics_seconds": round(t_stats, 2), "refine_seconds": round(t_refine, 2),
               "refine_rooms_per_s": round(summary["rooms"] / t_refine, 1), "cyclic_rooms": summary["cyclic_rooms"],
               "repaired_nodes": summary["repaired"]}
-    (w / "refine.json").write_text(json.dumps(result, indent=2))
-    print(json.dumps(result, indent=2))
+    report(result, w, "refine")
 
 
 if __name__ == "__main__":
