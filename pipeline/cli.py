@@ -53,6 +53,11 @@ def _guard(fn, *args, **kwargs):
         _fail(str(exc))
 
 
+def _stage(fn, config: Optional[Path], overrides: Optional[str], *args):
+    """Load and validate the config, then run a stage function on it (guarded)."""
+    return _guard(fn, _config(config, overrides), *args)
+
+
 @app.callback()
 def main(verbose: bool = typer.Option(False, "--verbose", "-v")) -> None:
     setup(verbose)
@@ -64,8 +69,7 @@ def ingest(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = Json
     """Read the configured source into canonical tables (rooms, architecture, objects, models, ground_truth)."""
     from .stages import ingest as stage
 
-    cfg = _config(config, config_json)
-    counts = _guard(stage.run, cfg, out)
+    counts = _stage(stage.run, config, config_json, out)
     _summary(counts)
 
 
@@ -77,8 +81,7 @@ def filter_(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = Jso
     from .filtering import rule_counts
     from .stages import filter as stage
 
-    cfg = _config(config, config_json)
-    report = _guard(stage.run, cfg, ingest_dir, out)
+    report = _stage(stage.run, config, config_json, ingest_dir, out)
     typer.echo(rule_counts(report).to_string(index=False))
 
 
@@ -89,8 +92,7 @@ def symmetry(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = Js
     """Assign a functional symmetry type to every model (config table, else detected from the mesh)."""
     from .stages import symmetry as stage
 
-    cfg = _config(config, config_json)
-    summary = _guard(stage.run, cfg, ingest_dir, out)
+    summary = _stage(stage.run, config, config_json, ingest_dir, out)
     typer.echo(f"models={summary['models']} agreement={summary['agreement']} ({summary['agree']}/{summary['compared']})")
 
 
@@ -104,8 +106,7 @@ def extract(shard: int = typer.Option(..., help="shard index"), config: Optional
     """Ray-cast one shard's rooms into raw relation graphs (nodes, edges)."""
     from .stages import extract as stage
 
-    cfg = _config(config, config_json)
-    summary = _guard(stage.run, cfg, shard, ingest_dir, filter_dir, out, symmetry_path)
+    summary = _stage(stage.run, config, config_json, shard, ingest_dir, filter_dir, out, symmetry_path)
     _summary(summary)
 
 
@@ -117,8 +118,7 @@ def score(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonO
     """Score extracted graphs against the source's ground truth (support parents, intended adjacencies)."""
     from .stages import score as stage
 
-    cfg = _config(config, config_json)
-    metrics = _guard(stage.run, cfg, ingest_dir, raw_dir, out)
+    metrics = _stage(stage.run, config, config_json, ingest_dir, raw_dir, out)
     _metrics(metrics)
 
 
@@ -129,8 +129,7 @@ def graph_stats(config: Optional[Path] = ConfigOpt, config_json: Optional[str] =
     """Dataset-wide statistics over every shard's raw graphs: co-occurrence, relation frequencies, hub patterns, sizes."""
     from .stages import graphs as stage
 
-    cfg = _config(config, config_json)
-    summary = _guard(stage.run_statistics, cfg, raw_dir, out)
+    summary = _stage(stage.run_statistics, config, config_json, raw_dir, out)
     _summary(summary)
 
 
@@ -143,8 +142,7 @@ def refine(shard: int = typer.Option(..., help="shard index"), config: Optional[
     """Superstructures, pruning and connectivity repair for one shard's raw graphs."""
     from .stages import graphs as stage
 
-    cfg = _config(config, config_json)
-    summary = _guard(stage.run_refine, cfg, shard, raw_dir, stats_dir, out)
+    summary = _stage(stage.run_refine, config, config_json, shard, raw_dir, stats_dir, out)
     _summary(summary, skip=("cyclic_room_ids",))
 
 
@@ -155,8 +153,7 @@ def gather_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str]
     """Concatenate the refined shards into results/graphs/{nodes,edges,superstructures}.parquet."""
     from .stages import graphs as stage
 
-    cfg = _config(config, config_json)
-    counts = _guard(stage.run_gather, cfg, final_dir, out)
+    counts = _stage(stage.run_gather, config, config_json, final_dir, out)
     _summary(counts)
 
 
@@ -168,8 +165,7 @@ def score_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str] 
     """Hub and chain precision / recall against the source's ground truth."""
     from .stages import score as stage
 
-    cfg = _config(config, config_json)
-    metrics = _guard(stage.run_superstructures, cfg, ingest_dir, graph_dir, out)
+    metrics = _stage(stage.run_superstructures, config, config_json, ingest_dir, graph_dir, out)
     _metrics(metrics)
 
 
