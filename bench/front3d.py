@@ -1,5 +1,6 @@
 """3D-FRONT ingest throughput on the 9-house sample (../shared/data/3d-front-sample): rooms/s with an empty mesh
-cache and with a warm one (parsed OBJ meshes are cached as .npz, so a re-run does not re-parse them).
+cache and with a warm one (parsed OBJ meshes are cached as .npz, so a re-run does not re-parse them), and how
+many outline walls a WallInner mesh backs.
 
     .venv/bin/python bench/front3d.py [--sample ../shared/data/3d-front-sample] [--repeat 5]
 """
@@ -9,6 +10,8 @@ import shutil
 import statistics
 import time
 from pathlib import Path
+
+import pandas as pd
 
 from pipeline import config as config_mod
 from pipeline.stages import ingest
@@ -33,9 +36,12 @@ def main() -> None:
         counts = ingest.run(cfg, args.workdir / "ingest")
         times.append(time.perf_counter() - t)
     warm = statistics.median(times[1:])
+    rep = pd.read_parquet(args.workdir / "ingest" / "ingest_report.parquet")
+    walls = rep[rep.kind == "wall"].set_index("status")["count"]
     result = {"houses": len(list((args.sample / "houses").glob("*.json"))), "rooms": counts["rooms"],
               "objects": counts["objects"], "first_run_seconds": round(times[0], 2),
-              "warm_runs_median_seconds": round(warm, 2), "rooms_per_s_warm": round(counts["rooms"] / warm, 1)}
+              "warm_runs_median_seconds": round(warm, 2), "rooms_per_s_warm": round(counts["rooms"] / warm, 1),
+              "walls_backed": int(walls.get("backed", 0)), "walls_open": int(walls.get("open", 0))}
     report(result, args.workdir, "front3d")
 
 

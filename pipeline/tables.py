@@ -126,8 +126,8 @@ SCHEMAS: dict[str, pa.Schema] = {
     "ingest_report": pa.schema([
         _f("source", _CAT),
         _f("item", _STR, doc="house / room / object / model the row is about"),
-        _f("kind", _CAT, doc="house | room | object | model | category"),
-        _f("status", _CAT, doc="read | skipped | kept | dropped | fallback | found"),
+        _f("kind", _CAT, doc="house | room | wall | object | model | category"),
+        _f("status", _CAT, doc="read | skipped | kept | dropped | fallback | found | backed | open"),
         _f("reason", _STR),
         _f("count", pa.int64()),
     ]),

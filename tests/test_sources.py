@@ -51,9 +51,22 @@ def test_front3d_fixture_house(tmp_path):
     assert reasons["room type 'Balcony' not mapped"] == 1 and reasons["no Floor mesh"] == 1
     assert reasons["box from Models.csv (no raw_model.obj)"] == 1
     assert any("broken.json: missing field 'mesh'" in r for r in rep.reason)  # reported, run continued
+    # one WallInner mesh, along the y = 0 wall: one of the four outline walls is backed, three are open
+    walls = rep[rep.kind == "wall"].set_index("status")["count"]
+    assert (walls["backed"], walls["open"]) == (1, 3)
     # the OBJ was cached: a second run reads the cache, not the file
     cache = front3d.MeshCache(FIX / "front3d/future", tmp_path / "cache")
     assert cache.get("jid-bed") is not None and (cache.hits, cache.parsed) == (1, 0)
+
+
+def test_wall_mesh_coverage_measures_each_outline_edge():
+    segs = np.array([[[0, 0], [4, 0]], [[4, 0], [4, 3]], [[4, 3], [0, 3]], [[0, 3], [0, 0]]], float)
+    along_half_of_first = [np.array([[0, 0], [2, 0], [2, 0.0], [0, 0.0]])]
+    off_by_ten_cm = [np.array([[0, 3.1], [4, 3.1]])]
+    assert front3d.wall_mesh_coverage(segs, along_half_of_first, 0.05) == pytest.approx([0.5, 0, 0, 0], abs=0.02)
+    assert front3d.wall_mesh_coverage(segs, off_by_ten_cm, 0.05) == pytest.approx([0, 0, 0, 0], abs=0.02)
+    assert front3d.wall_mesh_coverage(segs, off_by_ten_cm, 0.15)[2] == pytest.approx(1.0)
+    assert front3d.wall_mesh_coverage(segs, [], 0.05).tolist() == [0, 0, 0, 0]
 
 
 def test_front3d_quaternion_to_yaw():
@@ -85,6 +98,9 @@ def test_front3d_real_sample_houses(tmp_path):
     t = run_ingest("front3d", section, tmp_path)
     rooms, objs, rep = t["rooms"], t["objects"], t["ingest_report"]
     assert not (rep.kind.eq("house") & rep.status.eq("skipped")).any()  # every house parses
+    # every wall of every room read is reported as backed by a WallInner mesh or open; most are backed
+    walls = rep[rep.kind == "wall"].set_index("status")["count"]
+    assert walls.sum() == (t["architecture"].kind == "wall").sum() and walls["backed"] > walls["open"]
     want_rooms, want_objects = _independent_counts(sample / "houses", config.validate({})["front3d"]["room_types"])
     dropped = rep[(rep.kind == "object") & (rep.status == "dropped")]["count"].sum()
     emptied = rep[(rep.kind == "room") & rep.reason.str.contains("inside the floor outline")]["count"].sum()

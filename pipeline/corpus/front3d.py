@@ -151,16 +151,35 @@ def outline_of_triangles(xy_tris: list[np.ndarray]) -> np.ndarray:
     return merge_collinear(make_ccw(outline), tol=1e-3)
 
 
+def _mesh_xyz(mesh: dict, file: Path) -> np.ndarray:
+    """A house mesh's vertices in the project's Z-up world, (n, 3)."""
+    try:
+        return np.asarray(mesh["xyz"], float).reshape(-1, 3) @ WORLD.T
+    except (KeyError, ValueError) as exc:
+        raise HouseError(f"{file}: mesh {mesh.get('uid')}: bad 'xyz' ({exc})") from exc
+
+
 def _outline(floor_meshes: list[dict], file: Path) -> np.ndarray:
     tris = []
     for m in floor_meshes:
+        xyz = _mesh_xyz(m, file)
         try:
-            xyz = np.asarray(m["xyz"], float).reshape(-1, 3) @ WORLD.T
             faces = np.asarray(m["faces"], np.int64).reshape(-1, 3)
         except (KeyError, ValueError) as exc:
-            raise HouseError(f"{file}: mesh {m.get('uid')}: bad 'xyz'/'faces' ({exc})") from exc
+            raise HouseError(f"{file}: mesh {m.get('uid')}: bad 'faces' ({exc})") from exc
         tris += [xyz[t, :2] for t in faces]
     return outline_of_triangles(tris)
+
+
+def wall_mesh_coverage(segs: np.ndarray, footprints: list[np.ndarray], tolerance: float) -> np.ndarray:
+    """Share of each outline segment's length (segs: (n, 2, 2)) lying within ``tolerance`` of the floor-plane
+    footprint (convex hull of the (k, 2) vertices) of any wall mesh."""
+    hulls = [shapely.MultiPoint(f).convex_hull for f in footprints if len(f)]
+    if not hulls:
+        return np.zeros(len(segs))
+    band = unary_union(hulls).buffer(tolerance)
+    lines = [shapely.LineString(s) for s in segs]
+    return np.array([line.intersection(band).length / line.length if line.length else 0.0 for line in lines])
 
 
 def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, report: Counter) -> dict[str, list]:
@@ -204,17 +223,17 @@ def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, 
         except ValueError as exc:
             report[("room", "skipped", str(exc))] += 1
             continue
-        floor_z = min(float(np.min(np.asarray(m["xyz"], float).reshape(-1, 3)[:, 1])) for m in floors)
-        ceilings = [m for m in room_meshes if m.get("type") == "Ceiling"]
-        height = (max(float(np.max(np.asarray(m["xyz"], float).reshape(-1, 3)[:, 1])) for m in ceilings) - floor_z
-                  if ceilings else cfg["default_height"])
+        floor_z = min(float(_mesh_xyz(m, file)[:, 2].min()) for m in floors)
+        ceilings = [xyz[:, 2].max() for xyz in (_mesh_xyz(m, file) for m in room_meshes if m.get("type") == "Ceiling")
+                    if len(xyz)]
+        height = float(max(ceilings)) - floor_z if ceilings else cfg["default_height"]
         segs = polygon_segments(outline)
         walls = []
         for i, s in enumerate(segs):
             walls.append({"room_id": room_id, "element_id": f"wall_{i}", "kind": "wall", "x0": s[0][0], "y0": s[0][1],
                           "x1": s[1][0], "y1": s[1][1], "z0": 0.0, "z1": height, "thickness": cfg["wall_thickness"],
                           "wall_id": None})
-        out["architecture"] += walls + _openings(room_id, room_meshes, segs, floor_z)
+        out["architecture"] += walls + _openings(room_id, room_meshes, segs, floor_z, cfg, file)
         objects = []
         for c in valid:
             row = _object(room_id, len(objects), furniture[c["ref"]], c, catalogue, meshes, out["models"], floor_z,
@@ -237,10 +256,15 @@ def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, 
                              "extent_y": float(np.ptp(ys)), "n_objects": len(objects), "shard": None})
         out["objects"] += objects
         report[("room", "read", rtype)] += 1
+        backed = wall_mesh_coverage(segs, [_mesh_xyz(m, file)[:, :2] for m in room_meshes if m.get("type") == "WallInner"],
+                                    cfg["wall_mesh_tolerance"]) >= cfg["wall_mesh_min_coverage"]
+        report[("wall", "backed", "a WallInner mesh runs along it")] += int(backed.sum())
+        report[("wall", "open", "no WallInner mesh along it (open to a neighbour, or the mesh is another room's)")] += int((~backed).sum())
     return out
 
 
-def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: float) -> list[dict]:
+def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: float, cfg: dict,
+              file: Path) -> list[dict]:
     """Door and window meshes of the room, projected onto their nearest wall."""
     rows, counts = [], Counter()
     d = segs[:, 1] - segs[:, 0]
@@ -250,20 +274,21 @@ def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: 
         kind = OPENINGS.get(m.get("type"))
         if kind is None:
             continue
-        xyz = np.asarray(m.get("xyz", []), float).reshape(-1, 3) @ WORLD.T
+        xyz = _mesh_xyz(m, file)
         if not len(xyz):
             continue
         c = xyz[:, :2].mean(axis=0)
         rel = c - segs[:, 0]
         t = np.einsum("ij,ij->i", rel, u)
         off = np.abs(rel[:, 0] * u[:, 1] - rel[:, 1] * u[:, 0])
-        off = np.where((t >= -0.05) & (t <= length + 0.05), off, np.inf)
+        reach = cfg["opening_min_width"]
+        off = np.where((t >= -reach) & (t <= length + reach), off, np.inf)
         w = int(np.argmin(off))
-        if off[w] > 0.4:
+        if off[w] > cfg["opening_max_offset"]:
             continue  # not on this room's walls
         ts = (xyz[:, :2] - segs[w, 0]) @ u[w]
         t0, t1 = float(np.clip(ts.min(), 0, length[w])), float(np.clip(ts.max(), 0, length[w]))
-        if t1 - t0 < 0.05:
+        if t1 - t0 < cfg["opening_min_width"]:
             continue
         p0, p1 = segs[w, 0] + u[w] * t0, segs[w, 0] + u[w] * t1
         k = counts[kind]
