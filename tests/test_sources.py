@@ -59,6 +59,20 @@ def test_front3d_fixture_house(tmp_path):
     assert cache.get("jid-bed") is not None and (cache.hits, cache.parsed) == (1, 0)
 
 
+def test_front3d_malformed_wall_mesh_skips_the_house_with_file_and_field(tmp_path):
+    houses = tmp_path / "houses"
+    houses.mkdir()
+    house = json.loads((FIX / "front3d/houses/tinyhouse.json").read_text())
+    next(m for m in house["mesh"] if m["type"] == "WallInner")["xyz"] = [0, 0, 0, 4, 0]  # not a multiple of 3
+    (houses / "badwall.json").write_text(json.dumps(house))
+    t = run_ingest("front3d", {"houses": str(houses), "future": str(FIX / "front3d/future"),
+                               "cache_dir": str(tmp_path / "cache")}, tmp_path / "out")
+    rep = t["ingest_report"]
+    skipped = rep[(rep.kind == "house") & (rep.status == "skipped")].reason.tolist()
+    assert len(skipped) == 1 and "badwall.json: mesh wall1: bad 'xyz'" in skipped[0]
+    assert len(t["rooms"]) == 0
+
+
 def test_wall_mesh_coverage_measures_each_outline_edge():
     segs = np.array([[[0, 0], [4, 0]], [[4, 0], [4, 3]], [[4, 3], [0, 3]], [[0, 3], [0, 0]]], float)
     along_half_of_first = [np.array([[0, 0], [2, 0], [2, 0.0], [0, 0.0]])]
