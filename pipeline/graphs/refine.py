@@ -61,7 +61,7 @@ def refine_room(nodes: list[dict], raw_edges: list[dict], stats: Stats, cfg: dic
     _decide(edges, idx, stats, room_type, cfg)
     repaired = _repair_connectivity(edges, idx, cfg)
     _break_cycles(edges, idx, stats, room_type)
-    cyclic = _has_cycle(edges, idx)
+    cyclic = _has_cycle(edges)
     out_nodes = _node_roles(nodes, hubs, chains)
     for e in edges:
         e.setdefault("room_type", room_type)
@@ -291,11 +291,8 @@ def _break_cycles(edges: list[dict], idx: dict, stats: Stats, room_type: str) ->
     Weakness: rule order in ``BREAKABLE``, then lower relation frequency, then longer gap. Cycles whose
     every edge is a superstructure or support edge, or whose edges all carry reachability, stay (counted).
     """
-    live = [e for e in edges if e["status"] == "kept" and e["edge_type"] not in ARCHITECTURE_EDGES]
-    for _ in range(len(live)):
-        g = nx.DiGraph()
-        g.add_edges_from((e["source"], e["target"], {"e": e}) for e in edges
-                         if e["status"] == "kept" and e["edge_type"] not in ARCHITECTURE_EDGES)
+    for _ in range(len(edges)):  # each round prunes one kept edge or returns
+        g = _object_graph(edges)
         try:
             cycle = nx.find_cycle(g)
         except nx.NetworkXNoCycle:
@@ -315,11 +312,16 @@ def _break_cycles(edges: list[dict], idx: dict, stats: Stats, room_type: str) ->
             return  # nothing on this cycle can go: a documented cyclic case
 
 
-def _has_cycle(edges: list[dict], idx: dict) -> bool:
+def _object_graph(edges: list[dict]) -> nx.DiGraph:
+    """Kept edges other than architecture ones (each carries its row as ``e``): where cycles matter."""
     g = nx.DiGraph()
-    g.add_edges_from((e["source"], e["target"]) for e in edges
+    g.add_edges_from((e["source"], e["target"], {"e": e}) for e in edges
                      if e["status"] == "kept" and e["edge_type"] not in ARCHITECTURE_EDGES)
-    return not nx.is_directed_acyclic_graph(g)
+    return g
+
+
+def _has_cycle(edges: list[dict]) -> bool:
+    return not nx.is_directed_acyclic_graph(_object_graph(edges))
 
 
 def _node_roles(nodes: list[dict], hubs: list[Hub], chains: list[Chain]) -> list[dict]:
