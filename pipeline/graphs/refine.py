@@ -264,7 +264,7 @@ def _cheapest_path(edges, idx, kept, reach, target, allowed, allow_cycles, cc) -
         w = costs[kind] + (max(e["gap"] or 0.0, 0.0) if kind == "distant" else 0.0)
         if not g.has_edge(e["source"], e["target"]) or g[e["source"]][e["target"]]["w"] > w:
             g.add_edge(e["source"], e["target"], w=w, edge=e)
-    sources = [n for n in reach if n in g]
+    sources = sorted(n for n in reach if n in g)  # sorted: set order would follow PYTHONHASHSEED
     if target not in g or not sources:
         return None
     try:
