@@ -16,7 +16,7 @@ import shapely
 
 from .geometry import meshes, relations
 from .geometry.boxes import SIDE_NORMALS, SIDES, diagonal_2d, rotation
-from .geometry.polygon import inward_normals, merge_collinear, outline_from_loop, signed_area, wall_loop
+from .geometry.polygon import inward_normals, merge_collinear, outline_from_loop, segment_distances, signed_area, wall_loop
 from .geometry.raycast import RoomScene
 
 log = logging.getLogger("planit.extract")
@@ -171,7 +171,7 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) 
     radial = np.array([s[0] == "radial" for s in sym], bool)
     group = np.concatenate([np.where(tier <= 1, 0, parent + 1), np.zeros(n_walls, int)])  # who sees whom
     g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
-    _architecture_edges(g, room.room_id, walls, room.openings)
+    _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
     return g
 
 
@@ -355,7 +355,7 @@ def _contained_pairs(fp: np.ndarray, group: np.ndarray, fraction: float) -> set[
     return set(zip(i[sel].tolist(), j[sel].tolist()))
 
 
-def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings: list[dict]) -> None:
+def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings: list[dict], cfg: dict) -> None:
     """Wall loop (adjacent, with the corner angle), walls facing each other, doors and windows on their wall."""
     w = len(walls.ids)
     d = walls.dir
@@ -367,23 +367,20 @@ def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings: list
         g.edges.append(_edge(room_id, walls.ids[j], walls.ids[i], "wall_adjacent", "left", "adjacent", angle=angle, gap=0.0))
     for i in range(w):
         for j in range(w):
-            if i == j or abs(i - j) in (1, w - 1) or walls.normal[i] @ walls.normal[j] > -0.99:
+            if i == j or abs(i - j) in (1, w - 1) or walls.normal[i] @ walls.normal[j] > -cfg["facing_min_cos"]:
                 continue
             dist = float((walls.a[j] - walls.a[i]) @ walls.normal[i])
             t = np.sort([(walls.a[j] - walls.a[i]) @ d[i], (walls.b[j] - walls.a[i]) @ d[i]])
             overlap = min(t[1], walls.length[i]) - max(t[0], 0.0)
-            if dist > 0 and overlap >= 0.3 * min(walls.length[i], walls.length[j]):
+            if dist > 0 and overlap >= cfg["facing_min_overlap"] * min(walls.length[i], walls.length[j]):
                 g.edges.append(_edge(room_id, walls.ids[i], walls.ids[j], "wall_opposite", "front", "distant", gap=dist))
     for o in openings:
         mid = np.array([(o["x0"] + o["x1"]) / 2, (o["y0"] + o["y1"]) / 2])
-        rel = mid - walls.a
-        t = np.einsum("ij,ij->i", rel, d)
-        off = np.abs(np.einsum("ij,ij->i", rel, walls.normal))
-        on = (t >= -1e-3) & (t <= walls.length + 1e-3)
-        if not on.any() or off[on].min() > 0.05:
+        dist = segment_distances(mid, np.stack([walls.a, walls.b], axis=1))
+        wi = int(np.argmin(dist))
+        if dist[wi] > cfg["opening_tolerance"]:
             g.skipped.append((o["element_id"], "opening lies on no wall of the room"))
             continue
-        wi = int(np.flatnonzero(on)[np.argmin(off[on])])
         width = float(math.hypot(o["x1"] - o["x0"], o["y1"] - o["y0"]))
         g.nodes.append({"room_id": room_id, "node_id": o["element_id"], "kind": o["kind"], "category": o["kind"],
                         "model_id": None, "symmetry": "none", "symmetry_origin": "architecture", "tier": 0, "parent_id": None,

@@ -21,7 +21,8 @@ import shapely
 from shapely.ops import unary_union
 
 from ..geometry import meshes as M
-from ..geometry.polygon import make_ccw, merge_collinear, polygon_segments, signed_area
+from ..geometry.polygon import (make_ccw, merge_collinear, polygon_segments, segment_distances, segment_interval,
+                                signed_area)
 
 log = logging.getLogger("planit.front3d")
 
@@ -267,9 +268,6 @@ def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: 
               file: Path) -> list[dict]:
     """Door and window meshes of the room, projected onto their nearest wall."""
     rows, counts = [], Counter()
-    d = segs[:, 1] - segs[:, 0]
-    length = np.linalg.norm(d, axis=1)
-    u = d / length[:, None]
     for m in room_meshes:
         kind = OPENINGS.get(m.get("type"))
         if kind is None:
@@ -277,20 +275,13 @@ def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: 
         xyz = _mesh_xyz(m, file)
         if not len(xyz):
             continue
-        c = xyz[:, :2].mean(axis=0)
-        rel = c - segs[:, 0]
-        t = np.einsum("ij,ij->i", rel, u)
-        off = np.abs(rel[:, 0] * u[:, 1] - rel[:, 1] * u[:, 0])
-        reach = cfg["opening_min_width"]
-        off = np.where((t >= -reach) & (t <= length + reach), off, np.inf)
-        w = int(np.argmin(off))
-        if off[w] > cfg["opening_max_offset"]:
+        dist = segment_distances(xyz[:, :2].mean(axis=0), segs)
+        w = int(np.argmin(dist))
+        if dist[w] > cfg["opening_max_offset"]:
             continue  # not on this room's walls
-        ts = (xyz[:, :2] - segs[w, 0]) @ u[w]
-        t0, t1 = float(np.clip(ts.min(), 0, length[w])), float(np.clip(ts.max(), 0, length[w]))
-        if t1 - t0 < cfg["opening_min_width"]:
+        p0, p1 = segment_interval(xyz[:, :2], segs[w])
+        if np.linalg.norm(p1 - p0) < cfg["opening_min_width"]:
             continue
-        p0, p1 = segs[w, 0] + u[w] * t0, segs[w, 0] + u[w] * t1
         k = counts[kind]
         counts[kind] += 1
         rows.append({"room_id": room_id, "element_id": f"{kind}_{k}", "kind": kind, "x0": p0[0], "y0": p0[1],

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry import meshes as M
+from ..geometry.polygon import segment_distances, segment_interval
 
 GROUPS = {"bedrooms": "bedroom", "living_rooms": "living", "kitchens": "kitchen", "bathrooms": "bathroom"}
 PARTS = {"Drawer", "Cabinet", "Shelf", "StoveBurner", "StoveKnob", "Faucet", "SinkBasin", "BathtubBasin", "ShowerHead"}
@@ -204,15 +205,8 @@ def _face_away_from_wall(yaw, centre, half, corners, outline):
 
 
 def _window(room_id: str, k: int, corners: np.ndarray, segs: np.ndarray, floor_z: float) -> dict:
-    c = corners[:, :2].mean(axis=0)
-    d = segs[:, 1] - segs[:, 0]
-    length = np.linalg.norm(d, axis=1)
-    u = d / length[:, None]
-    rel = c - segs[:, 0]
-    off = np.abs(rel[:, 0] * u[:, 1] - rel[:, 1] * u[:, 0])
-    w = int(np.argmin(off))
-    ts = np.clip((corners[:, :2] - segs[w, 0]) @ u[w], 0, length[w])
-    p0, p1 = segs[w, 0] + u[w] * ts.min(), segs[w, 0] + u[w] * ts.max()
+    w = int(np.argmin(segment_distances(corners[:, :2].mean(axis=0), segs)))
+    p0, p1 = segment_interval(corners[:, :2], segs[w])
     return {"room_id": room_id, "element_id": f"window_{k}", "kind": "window", "x0": p0[0], "y0": p0[1], "x1": p1[0],
             "y1": p1[1], "z0": float(corners[:, 2].min() - floor_z), "z1": float(corners[:, 2].max() - floor_z),
             "thickness": None, "wall_id": f"wall_{w}"}

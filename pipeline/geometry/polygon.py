@@ -47,6 +47,23 @@ def polygon_segments(xy: np.ndarray) -> np.ndarray:
     return np.stack([xy, np.roll(xy, -1, axis=0)], axis=1)
 
 
+def segment_distances(point: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Distance from one ``(2,)`` point to each of ``(m, 2, 2)`` segments (to the nearest point on it)."""
+    a, d = segments[:, 0], segments[:, 1] - segments[:, 0]
+    length2 = np.einsum("ij,ij->i", d, d)
+    t = np.clip(np.einsum("ij,ij->i", np.asarray(point, float) - a, d) / np.maximum(length2, 1e-18), 0.0, 1.0)
+    return np.linalg.norm(a + t[:, None] * d - point, axis=1)
+
+
+def segment_interval(points: np.ndarray, segment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """End points of the stretch of ``segment`` ((2, 2)) that ``(k, 2)`` points project onto, clipped to it."""
+    a, d = segment[0], segment[1] - segment[0]
+    length = float(np.linalg.norm(d))
+    u = d / length
+    t = np.clip((np.asarray(points, float) - a) @ u, 0.0, length)
+    return a + u * t.min(), a + u * t.max()
+
+
 def inward_normals(segments: np.ndarray) -> np.ndarray:
     """Unit normals pointing into the room for counter-clockwise wall segments (left of travel)."""
     d = segments[:, 1] - segments[:, 0]
