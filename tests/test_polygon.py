@@ -1,8 +1,11 @@
+import math
+
 import numpy as np
+import pytest
 from hypothesis import given, strategies as st
 
 from pipeline.geometry.polygon import (extents, make_ccw, merge_collinear, outline_from_loop, polygon_segments,
-                                       signed_area, wall_loop)
+                                       segment_distances, segment_interval, signed_area, wall_loop)
 
 SQUARE = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], float)
 L_SHAPE = np.array([[0, 0], [4, 0], [4, 2], [2, 2], [2, 4], [0, 4]], float)
@@ -74,3 +77,13 @@ def test_wall_loop_properties(poly, seed, cut):
     assert not wall_loop(broken, tol=1e-3)[0]
     # dropping a wall opens it too
     assert not wall_loop(np.delete(segs, k, axis=0))[0]
+
+
+def test_point_to_wall_distance_and_projection():
+    segs = np.array([[[0, 0], [4, 0]], [[4, 0], [4, 3]]], float)
+    assert segment_distances(np.array([2.0, 0.3]), segs) == pytest.approx([0.3, 2.0])
+    # past both walls' ends: the distance to their end points, not to their lines (1 and 4)
+    assert segment_distances(np.array([5.0, 4.0]), segs) == pytest.approx([math.hypot(1, 4), math.hypot(1, 1)])
+    # a door's corners project onto the stretch they cover, clipped to the wall
+    p0, p1 = segment_interval(np.array([[1.0, 0.1], [1.9, -0.1], [5.0, 0.0]]), segs[0])
+    assert p0 == pytest.approx([1.0, 0.0]) and p1 == pytest.approx([4.0, 0.0])
