@@ -1,4 +1,4 @@
-"""One way to open DuckDB for the pipeline's statistics.
+"""The one way the pipeline opens DuckDB (statistics, the graph report, `planit stats`).
 
 DuckDB sums floating-point values in whatever order its threads finish, so ``avg`` over DOUBLE columns can
 differ in the last bits between a 2-core laptop and a 1-CPU cluster job. Outputs must be identical however

@@ -374,9 +374,10 @@ def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings: list
             overlap = min(t[1], walls.length[i]) - max(t[0], 0.0)
             if dist > 0 and overlap >= cfg["facing_min_overlap"] * min(walls.length[i], walls.length[j]):
                 g.edges.append(_edge(room_id, walls.ids[i], walls.ids[j], "wall_opposite", "front", "distant", gap=dist))
+    segments = np.stack([walls.a, walls.b], axis=1)
     for o in openings:
         mid = np.array([(o["x0"] + o["x1"]) / 2, (o["y0"] + o["y1"]) / 2])
-        dist = segment_distances(mid, np.stack([walls.a, walls.b], axis=1))
+        dist = segment_distances(mid, segments)
         wi = int(np.argmin(dist))
         if dist[wi] > cfg["opening_tolerance"]:
             g.skipped.append((o["element_id"], "opening lies on no wall of the room"))

@@ -4,12 +4,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TextIO
 
-import duckdb
 import pyarrow.parquet as pq
 from rich.console import Console
 from rich.table import Table
 
-from . import tables
+from . import duck, tables
 
 
 def table_summary(path: str | Path, stream: TextIO) -> None:
@@ -25,7 +24,7 @@ def table_summary(path: str | Path, stream: TextIO) -> None:
     console.print(f"[bold]{path}[/bold]")
     for key, value in tables.metadata(path).items():
         console.print(f"  {key}: {value}")
-    con = duckdb.connect()
+    con = duck.connect()
     rows = con.execute("SELECT count(*) FROM read_parquet(?)", [str(path)]).fetchone()[0]
     console.print(f"  rows: {rows}")
     summary = {r[0]: r for r in con.execute("SUMMARIZE SELECT * FROM read_parquet(?)", [str(path)]).fetchall()}
