@@ -1,22 +1,25 @@
-"""Load and validate the pipeline configuration against ``config/schema.yaml``.
+"""Load and validate the pipeline configuration against the package's ``schema.yaml`` (JSON Schema 2020-12).
 
-The same schema validates the config in the Snakefile (``snakemake.utils.validate``) and in the CLI, so a
-stage run by hand sees exactly the defaults a Snakemake run sees.
+The same validator runs in the Snakefile (``rules/common.smk``) and in the CLI, so a stage run by hand sees
+exactly the defaults a Snakemake run sees, and a bad value gives the same one-line message in both. The
+schema is package data (``importlib.resources``), so an installed wheel validates without the source tree;
+``config/schema.yaml`` links to it.
 """
 from __future__ import annotations
 
 import hashlib
 import json
+from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 import jsonschema
 import yaml
 
-SCHEMA_PATH = Path(__file__).resolve().parents[1] / "config" / "schema.yaml"
+from .errors import PlanitError
 
 
-class ConfigError(ValueError):
+class ConfigError(PlanitError):
     """The configuration is invalid; the message names the file and the offending key."""
 
 
@@ -33,12 +36,16 @@ def _with_defaults(validator_class):
     return jsonschema.validators.extend(validator_class, {"properties": set_defaults})
 
 
-_Validator = _with_defaults(jsonschema.Draft7Validator)
+_Validator = _with_defaults(jsonschema.Draft202012Validator)
+_SCHEMA: dict | None = None
 
 
 def load_schema() -> dict:
-    with open(SCHEMA_PATH) as fh:
-        return yaml.safe_load(fh)
+    """The configuration schema shipped inside the package."""
+    global _SCHEMA
+    if _SCHEMA is None:
+        _SCHEMA = yaml.safe_load(resources.files("pipeline").joinpath("schema.yaml").read_text())
+    return _SCHEMA
 
 
 def deep_merge(base: dict, override: dict) -> dict:
@@ -52,14 +59,19 @@ def deep_merge(base: dict, override: dict) -> dict:
     return out
 
 
+def _one_line(message: str, limit: int = 160) -> str:
+    message = " ".join(message.split())
+    return message if len(message) <= limit else message[: limit - 3] + "..."
+
+
 def validate(config: dict, origin: str = "<config>") -> dict:
-    """Validate ``config`` in place, filling defaults; raise ConfigError naming the offending key."""
+    """Validate ``config`` in place, filling defaults; raise ConfigError naming the offending key in one line."""
     validator = _Validator(load_schema())
     errors = sorted(validator.iter_errors(config), key=lambda e: list(e.absolute_path))
     if errors:
         err = errors[0]
         key = ".".join(str(p) for p in err.absolute_path) or "<top level>"
-        raise ConfigError(f"{origin}: invalid config at key '{key}': {err.message}")
+        raise ConfigError(f"{origin}: invalid config at key '{key}': {_one_line(err.message)}")
     return config
 
 
@@ -75,7 +87,7 @@ def load(path: str | Path | None = None, overrides_json: str | None = None) -> d
         except OSError as exc:
             raise ConfigError(f"{path}: cannot read config: {exc.strerror}") from exc
         except yaml.YAMLError as exc:
-            raise ConfigError(f"{path}: not valid YAML: {exc}") from exc
+            raise ConfigError(f"{path}: not valid YAML: {_one_line(str(exc))}") from exc
         if not isinstance(config, dict):
             raise ConfigError(f"{path}: the config must be a mapping at the top level")
     if overrides_json:
@@ -86,6 +98,32 @@ def load(path: str | Path | None = None, overrides_json: str | None = None) -> d
         config = deep_merge(config, overrides)
         origin += " + --config-json"
     return validate(config, origin)
+
+
+def pick(config: dict, keys: Iterable[str]) -> dict:
+    """The nested sub-config holding exactly the dotted ``keys`` (``"extract.support"``, ``"seed"``).
+
+    A Snakemake rule passes this as its params, so the rule reruns exactly when a key it reads changes.
+    """
+    out: dict = {}
+    for key in keys:
+        parts = key.split(".")
+        value: Any = config
+        for p in parts:
+            if not isinstance(value, dict) or p not in value:
+                raise ConfigError(f"no config key '{key}'")
+            value = value[p]
+        node = out
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+        node[parts[-1]] = value
+    return out
+
+
+def restrict(config: dict, shape: dict) -> dict:
+    """``config`` cut down to the keys that ``shape`` (a nested dict, e.g. a rule's params) holds."""
+    return {k: restrict(config[k], v) if isinstance(v, dict) and v and isinstance(config.get(k), dict) else config[k]
+            for k, v in shape.items()}
 
 
 def config_hash(section: Any) -> str:

@@ -5,8 +5,6 @@ report row names the first rule that rejected it and lists every rule it fails.
 """
 from __future__ import annotations
 
-import zlib
-
 import numpy as np
 import pandas as pd
 import shapely
@@ -19,14 +17,11 @@ RULES = ("unknown_room_type", "wall_loop", "room_height", "room_size", "too_few_
 
 
 def category_room_counts(rooms: pd.DataFrame, objects: pd.DataFrame) -> pd.DataFrame:
-    """Rooms of each type that hold each category (a room counts once)."""
-    pairs = objects[["room_id", "category"]].drop_duplicates().merge(rooms[["room_id", "room_type"]], on="room_id")
-    return pairs.groupby(["room_type", "category"], observed=True).size().rename("rooms").reset_index()
-
-
-def shard_of(room_id: str, shards: int) -> int:
-    """Stable shard index of a room (crc32 of its id): independent of corpus order and size."""
-    return zlib.crc32(room_id.encode()) % shards
+    """Rooms of each type that hold each category (a room counts once): ``room_type, category, rooms``."""
+    pairs = objects[["room_id", "category"]].astype({"category": str}).drop_duplicates()
+    pairs = pairs.merge(rooms[["room_id", "room_type"]].astype({"room_type": str}), on="room_id")
+    return (pairs.groupby(["room_type", "category"]).size().rename("rooms").reset_index()
+            .sort_values(["room_type", "category"], ignore_index=True))
 
 
 def _room_reasons(room, walls: pd.DataFrame, objs: pd.DataFrame, cfg: dict, rare: set) -> list[tuple[str, str]]:
@@ -79,10 +74,14 @@ def _room_reasons(room, walls: pd.DataFrame, objs: pd.DataFrame, cfg: dict, rare
 
 
 def filter_rooms(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.DataFrame, cfg: dict,
-                 shards: int) -> pd.DataFrame:
-    """One report row per room: kept or rejected, first rule, every rule, detail, shard (kept rooms)."""
-    counts = category_room_counts(rooms, objects)
-    rare = set(map(tuple, counts.loc[counts["rooms"] < cfg["min_category_rooms"], ["room_type", "category"]].to_numpy()))
+                 counts: pd.DataFrame) -> pd.DataFrame:
+    """One report row per room: kept or rejected, first rule, every rule, detail, shard (kept rooms).
+
+    ``counts`` holds the dataset-wide :func:`category_room_counts` (the rare-category rule needs every room,
+    while a filter job sees one shard).
+    """
+    rare = set(map(tuple, counts.loc[counts["rooms"] < cfg["min_category_rooms"], ["room_type", "category"]]
+                   .astype(str).to_numpy()))
     walls = architecture[architecture["kind"].astype(str) == "wall"]
     walls_by_room = dict(tuple(walls.groupby("room_id", sort=False)))
     objs_by_room = dict(tuple(objects.groupby("room_id", sort=False)))
@@ -95,8 +94,8 @@ def filter_rooms(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.Da
         rows.append({"room_id": room.room_id, "room_type": room.room_type, "status": "kept" if kept else "rejected",
                      "rule": None if kept else reasons[0][0], "rules": [r for r, _ in reasons],
                      "detail": "" if kept else "; ".join(f"{r}: {d}" for r, d in reasons),
-                     "shard": shard_of(room.room_id, shards) if kept else None})
-    return pd.DataFrame(rows)
+                     "shard": room.shard if kept else None})
+    return pd.DataFrame(rows, columns=["room_id", "room_type", "status", "rule", "rules", "detail", "shard"])
 
 
 def rule_counts(report: pd.DataFrame) -> pd.DataFrame:

@@ -16,6 +16,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from . import __version__
+from .errors import PlanitError
 
 COORDINATES = "metres; right-handed, Z up; object front = local +Y, right = local +X; yaw CCW about +Z (rad)"
 
@@ -29,7 +30,7 @@ _UMASK = os.umask(0)
 os.umask(_UMASK)
 
 
-class TableError(ValueError):
+class TableError(PlanitError):
     """A table file is unreadable or lacks a field; the message names the file and field."""
 
 
@@ -209,6 +210,16 @@ SCHEMAS["hub_patterns"] = pa.schema([
     _f("count", pa.int64(), doc="candidate hub arrangements seen in the raw graphs"),
     _f("accepted", pa.bool_(), doc="count >= refine.hub_min_pattern_count"),
 ])
+SCHEMAS["category_counts"] = pa.schema([
+    _f("room_type", _CAT), _f("category", _STR),
+    _f("rooms", pa.int64(), doc="ingested rooms of the type holding the category (a room counts once)"),
+])
+SCHEMAS["partial_counts"] = pa.schema([
+    _f("kind", _CAT, doc="cooccurrence | relation | hub_pattern: one shard's share of a dataset-wide count"),
+    _f("room_type", _CAT), _f("cat_a", _STR, doc="anchor (hub) category"), _f("cat_b", _STR, doc="target (spoke) category"),
+    _f("direction", _CAT), _f("distance", _CAT),
+    _f("count", pa.int64(), doc="rooms (cooccurrence, relation) or candidate hubs (hub_pattern) in the shard"),
+])
 SCHEMAS["category_sizes"] = pa.schema([
     _f("room_type", _CAT), _f("category", _STR), _f("instances", pa.int64()),
     _f("mean_area", _F64, "m^2", "mean projected (footprint) box area"),
@@ -282,21 +293,72 @@ def write_tsv(path: str | Path, frame) -> Path:
     return _atomic(Path(path), lambda tmp: frame.to_csv(tmp, sep="\t", index=False))
 
 
-def read(path: str | Path, name: str | None = None, filters=None) -> pa.Table:
-    """Read a pipeline table; with ``name``, check every field of that schema is present."""
+def write_csv(path: str | Path, frame) -> Path:
+    """A comma-separated side file from a DataFrame, written atomically."""
+    return _atomic(Path(path), lambda tmp: frame.to_csv(tmp, index=False))
+
+
+def write_figure(path: str | Path, figure, **savefig) -> Path:
+    """A matplotlib figure, written atomically (the format follows ``path``'s suffix)."""
+    fmt = Path(path).suffix.lstrip(".") or "png"
+    return _atomic(Path(path), lambda tmp: figure.savefig(tmp, format=fmt, **savefig))
+
+
+def read(path: str | Path, name: str | None = None, filters=None, columns: list[str] | None = None) -> pa.Table:
+    """Read a pipeline table; with ``name``, check every field of that schema is present. ``filters`` (pyarrow
+    DNF, e.g. ``[("room_id", "in", ids)]``) are pushed down to the row groups; ``columns`` reads only those."""
+    if name is not None:
+        check(path, name)
+    try:
+        wanted = columns if columns is not None else (SCHEMAS[name].names if name is not None else None)
+        return pq.read_table(path, filters=filters, columns=wanted)
+    except FileNotFoundError as exc:
+        raise TableError(f"{path}: no such table file") from exc
+    except (pa.ArrowInvalid, OSError) as exc:
+        raise TableError(f"{path}: not a readable Parquet file: {exc}") from exc
+
+
+def check(path: str | Path, name: str) -> None:
+    """Fail with a TableError naming the file unless it is a readable table holding every field of ``name``
+    (reads the footer only)."""
     path = Path(path)
     if not path.exists():
         raise TableError(f"{path}: no such table file")
     try:
-        table = pq.read_table(path, filters=filters)
+        present = set(pq.read_schema(path).names)
     except (pa.ArrowInvalid, OSError) as exc:
         raise TableError(f"{path}: not a readable Parquet file: {exc}") from exc
-    if name is not None:
-        missing = [f.name for f in SCHEMAS[name] if f.name not in table.column_names]
-        if missing:
-            raise TableError(f"{path}: table '{name}' lacks field(s) {', '.join(missing)}")
-        table = table.select(SCHEMAS[name].names)
-    return table
+    missing = [f.name for f in SCHEMAS[name] if f.name not in present]
+    if missing:
+        raise TableError(f"{path}: table '{name}' lacks field(s) {', '.join(missing)}")
+
+
+def read_many(paths, name: str, columns: list[str] | None = None, filters=None) -> pa.Table:
+    """Concatenate tables of one schema (shards of a stage's output), in the given order."""
+    parts = [read(p, name, filters=filters, columns=columns) for p in paths]
+    if not parts:
+        table = empty(name)
+        return table.select(columns) if columns else table
+    return pa.concat_tables(parts).combine_chunks()
+
+
+def records_by_room(path: str | Path, name: str) -> dict[str, list[dict]]:
+    """A table's rows as plain dicts (strings, floats, None for nulls), grouped by ``room_id`` in file order."""
+    df = read(path, name).to_pandas()
+    for col in df.columns:
+        if hasattr(df[col], "cat"):
+            df[col] = df[col].astype(object)
+    df = df.astype(object).where(df.notna(), None)
+    return {k: g.to_dict("records") for k, g in df.groupby("room_id", sort=False)}
+
+
+def model_mesh(row: dict):
+    """(vertices (n, 3) float, faces (m, 3) int) of a ``models`` table row."""
+    import numpy as np
+
+    v = np.asarray(row["vertices"] if row["vertices"] is not None else [], dtype=float).reshape(-1, 3)
+    f = np.asarray(row["faces"] if row["faces"] is not None else [], dtype=np.int64).reshape(-1, 3)
+    return v, f
 
 
 def metadata(path: str | Path) -> dict[str, str]:

@@ -1,27 +1,113 @@
-# Config validation and helpers shared by every rule file (no lambdas in rules).
+# Config validation, every output path (defined here once) and the helpers every rule file uses (no lambdas in rules).
 import json
+import os
+import shlex
+import sys
+from pathlib import Path
 
-from snakemake.utils import validate
+from snakemake.exceptions import WorkflowError
 
+try:
+    from pipeline import config as planit_config
+except ImportError as exc:
+    raise WorkflowError(f"the planit package is not installed for the Python running Snakemake ({sys.executable}): "
+                        "run `make setup` and use .venv/bin/snakemake") from exc
 
-validate(config, schema="../config/schema.yaml")
+try:  # the CLI's validator: same defaults, and a bad key is named in one line
+    planit_config.validate(config, "config")
+except planit_config.ConfigError as exc:
+    raise WorkflowError(str(exc)) from None
+
+# Jobs call the `planit` installed beside the Python that runs Snakemake, whether or not a venv is activated
+# (with --sdm conda, the rule's environment comes first on PATH). Each stage sees only the keys its rule passes.
+os.environ["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"
+os.environ["PLANIT_STRICT_KEYS"] = "1"
+# the conda environment's post-deploy script installs this package from here
+os.environ["PLANIT_SOURCE"] = str(Path(workflow.basedir).resolve())
 
 SHARDS = list(range(config["shards"]))
+CORPORA = ["ingested", *sorted(config["corpora"])]
+ENV = "../environment.yml"
 
 
-def stage_json(*sections):
-    """The config sections a stage reads, as JSON for `planit ... --config-json`.
+wildcard_constraints:
+    corpus="[a-z][a-z0-9_]*",
+    shard="[0-9]+",
 
-    Passing only its own sections to each rule makes Snakemake rerun a stage (and what depends on it)
-    exactly when those sections change (params are a rerun trigger).
-    """
-    return json.dumps({s: config[s] for s in sections}, sort_keys=True, separators=(",", ":"))
+
+# ------------------------------------------------------------------------------------------- paths
+INGEST = "results/ingest/shards/{table}-{shard}.parquet"
+INGEST_TABLES = ["rooms", "architecture", "objects", "models", "ground_truth", "ingest_report"]
+CATEGORY_COUNTS = "results/ingest/category_counts.parquet"
+INGEST_REPORT = "results/ingest/ingest_report.parquet"
+FILTER_ROOMS = "results/filter/shards/rooms-{shard}.parquet"
+FILTER_SHARD_REPORT = "results/filter/shards/report-{shard}.parquet"
+FILTER_REPORT = "results/filter/report.parquet"
+RULE_COUNTS = "results/filter/rule_counts.tsv"
+GRAPHS = "results/graphs/{corpus}"
+SYMMETRY = GRAPHS + "/symmetry.parquet"
+SYMMETRY_AGREEMENT = GRAPHS + "/symmetry_agreement.json"
+RAW = GRAPHS + "/raw/{table}-{shard}.parquet"
+RAW_SUMMARY = GRAPHS + "/raw/summary-{shard}.json"
+PARTIAL = GRAPHS + "/stats/partial-{shard}.parquet"
+CANDIDATES = GRAPHS + "/stats/candidates-{shard}.parquet"
+STATS = GRAPHS + "/stats/{name}.parquet"
+STAT_TABLES = ["cooccurrence", "relations", "hub_patterns", "category_sizes"]
+FINAL = GRAPHS + "/final/{table}-{shard}.parquet"
+FINAL_SUMMARY = GRAPHS + "/final/summary-{shard}.json"
+GATHERED = GRAPHS + "/{table}.parquet"
+REPORT = GRAPHS + "/report/{name}"
+METRICS = "results/metrics/{corpus}/{name}.json"
+
+
+def keys(*dotted):
+    """The config keys a rule's stage reads, as JSON for `planit ... --config-json` (a rerun trigger: the rule
+    reruns exactly when one of these keys changes)."""
+    return json.dumps(planit_config.pick(config, dotted), sort_keys=True, separators=(",", ":"))
+
+
+def shards_of(template, **fixed):
+    """Every shard's path of a template (a gather's input)."""
+    return expand(template, shard=SHARDS, allow_missing=True, **fixed)
+
+
+def repeat(flag, name):
+    """Params function: `--flag path` for each file of the named input (the CLI takes lists as repeated options)."""
+
+    def options(wildcards, input):
+        return " ".join(f"{flag} {shlex.quote(str(p))}" for p in input[name])
+
+    return options
+
+
+# ------------------------------------------------------------------------------------------- corpora
+def corpus_path(corpus, table, shard):
+    """Canonical table `table` of shard `shard` of a corpus: the ingested rooms kept by the filter, or a folder
+    named in config `corpora`."""
+    if corpus == "ingested":
+        return FILTER_ROOMS.format(shard=shard) if table == "rooms" else INGEST.format(table=table, shard=shard)
+    if corpus not in config["corpora"]:
+        raise WorkflowError(f"unknown corpus '{corpus}' (config 'corpora' names {sorted(config['corpora'])})")
+    return f"{config['corpora'][corpus]}/{table}-{shard}.parquet"
+
+
+def get_corpus_shard(wildcards):
+    """The four canonical tables of one shard of a corpus (extraction's input)."""
+    return {t: corpus_path(wildcards.corpus, t, wildcards.shard) for t in ("rooms", "architecture", "objects", "models")}
+
+
+def get_corpus_models(wildcards):
+    return [corpus_path(wildcards.corpus, "models", k) for k in SHARDS]
+
+
+def get_corpus_ground_truth(wildcards):
+    return [corpus_path(wildcards.corpus, "ground_truth", k) for k in SHARDS]
 
 
 def get_final_outputs():
     return [
-        "results/filter/report.parquet",
-        "results/metrics/extraction.json",
-        "results/metrics/superstructures.json",
-        "results/graphs/report/table1.csv",
+        FILTER_REPORT,
+        INGEST_REPORT,
+        *expand(METRICS, corpus="ingested", name=["extraction", "superstructures"]),
+        *expand(REPORT, corpus="ingested", name="table1.csv"),
     ]

@@ -1,55 +1,63 @@
-# Raw relation graphs: model symmetry (gather), per-shard Embree extraction, scores against ground truth.
+# Raw relation graphs of any corpus: model symmetry (gather), per-shard Embree extraction, scores against ground truth.
 
 
 rule symmetry:
     input:
-        models=rules.ingest.output.models,
+        models=get_corpus_models,
     output:
-        table="results/symmetry/symmetry.parquet",
-        agreement="results/symmetry/agreement.json",
+        table=SYMMETRY,
+        agreement=SYMMETRY_AGREEMENT,
     params:
-        settings=stage_json("seed", "extract"),
+        config=keys("seed", "extract.symmetry"),
+        models=repeat("--models", "models"),
     log:
-        "logs/symmetry/symmetry.log",
+        "logs/symmetry/{corpus}.log",
     benchmark:
-        "benchmarks/symmetry/symmetry.tsv"
+        "benchmarks/symmetry/{corpus}.tsv"
+    conda:
+        ENV
     shell:
-        "planit symmetry --config-json {params.settings:q} --ingest results/ingest --out results/symmetry 2> {log}"
+        "planit symmetry --config-json {params.config:q} {params.models} --out-table {output.table} "
+        "--out-agreement {output.agreement} 2> {log}"
 
 
 rule extract_graphs:
     input:
-        rooms=rules.filter_rooms.output.rooms,
-        architecture=rules.ingest.output.architecture,
-        objects=rules.ingest.output.objects,
-        models=rules.ingest.output.models,
-        symmetry=rules.symmetry.output.table,
+        unpack(get_corpus_shard),
+        symmetry=SYMMETRY,
     output:
-        nodes="results/graphs/raw/nodes-{shard}.parquet",
-        edges="results/graphs/raw/edges-{shard}.parquet",
-        summary="results/graphs/raw/summary-{shard}.json",
+        nodes=RAW.replace("{table}", "nodes"),
+        edges=RAW.replace("{table}", "edges"),
+        summary=RAW_SUMMARY,
     params:
-        settings=stage_json("extract"),
+        config=keys("extract.backend", "extract.support", "extract.spatial", "extract.distance", "extract.architecture"),
     log:
-        "logs/extract_graphs/{shard}.log",
+        "logs/extract_graphs/{corpus}-{shard}.log",
     benchmark:
-        "benchmarks/extract_graphs/{shard}.tsv"
+        "benchmarks/extract_graphs/{corpus}-{shard}.tsv"
+    conda:
+        ENV
     shell:
-        "planit extract --shard {wildcards.shard} --config-json {params.settings:q} --ingest results/ingest "
-        "--filter results/filter --symmetry {input.symmetry} --out results/graphs/raw 2> {log}"
+        "planit extract --shard {wildcards.shard} --config-json {params.config:q} --rooms {input.rooms} "
+        "--architecture {input.architecture} --objects {input.objects} --models {input.models} "
+        "--symmetry {input.symmetry} --out-nodes {output.nodes} --out-edges {output.edges} "
+        "--out-summary {output.summary} 2> {log}"
 
 
 rule score_extraction:
     input:
-        ground_truth=rules.ingest.output.ground_truth,
-        edges=expand("results/graphs/raw/edges-{shard}.parquet", shard=SHARDS),
-        nodes=expand("results/graphs/raw/nodes-{shard}.parquet", shard=SHARDS),
+        nodes=shards_of(RAW, table="nodes"),
+        edges=shards_of(RAW, table="edges"),
+        ground_truth=get_corpus_ground_truth,
     output:
-        metrics="results/metrics/extraction.json",
+        metrics=METRICS.replace("{name}", "extraction"),
     params:
-        settings=stage_json("source", "shards"),
+        nodes=repeat("--nodes", "nodes"),
+        edges=repeat("--edges", "edges"),
+        ground_truth=repeat("--ground-truth", "ground_truth"),
     log:
-        "logs/score_extraction/score_extraction.log",
+        "logs/score_extraction/{corpus}.log",
+    conda:
+        ENV
     shell:
-        "planit score --config-json {params.settings:q} --ingest results/ingest --raw results/graphs/raw "
-        "--out {output.metrics} 2> {log}"
+        "planit score {params.nodes} {params.edges} {params.ground_truth} --out {output.metrics} > {log} 2>&1"

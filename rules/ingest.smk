@@ -1,38 +1,77 @@
-# Sources -> canonical tables; room filtering and sharding.
+# Sources -> canonical tables, one job per shard; the ingest summary (gather); room filtering per shard.
 
 
 rule ingest:
     output:
-        rooms="results/ingest/rooms.parquet",
-        architecture="results/ingest/architecture.parquet",
-        objects="results/ingest/objects.parquet",
-        models="results/ingest/models.parquet",
-        ground_truth="results/ingest/ground_truth.parquet",
-        report="results/ingest/ingest_report.parquet",
+        **{t: INGEST.replace("{table}", t) for t in INGEST_TABLES},
     params:
-        settings=stage_json("seed", "source", config["source"]),
+        config=keys("seed", "source", "shards", config["source"]),
     log:
-        "logs/ingest/ingest.log",
+        "logs/ingest/{shard}.log",
     benchmark:
-        "benchmarks/ingest/ingest.tsv"
+        "benchmarks/ingest/{shard}.tsv"
+    conda:
+        ENV
     shell:
-        "planit ingest --config-json {params.settings:q} --out results/ingest 2> {log}"
+        "planit ingest --shard {wildcards.shard} --config-json {params.config:q} --rooms {output.rooms} "
+        "--architecture {output.architecture} --objects {output.objects} --models {output.models} "
+        "--ground-truth {output.ground_truth} --report {output.ingest_report} 2> {log}"
+
+
+rule ingest_summary:
+    input:
+        rooms=shards_of(INGEST, table="rooms"),
+        objects=shards_of(INGEST, table="objects"),
+        reports=shards_of(INGEST, table="ingest_report"),
+    output:
+        counts=CATEGORY_COUNTS,
+        report=INGEST_REPORT,
+    params:
+        rooms=repeat("--rooms", "rooms"),
+        objects=repeat("--objects", "objects"),
+        reports=repeat("--report", "reports"),
+    log:
+        "logs/ingest_summary/ingest_summary.log",
+    conda:
+        ENV
+    shell:
+        "planit ingest-summary {params.rooms} {params.objects} {params.reports} --out-counts {output.counts} "
+        "--out-report {output.report} 2> {log}"
 
 
 rule filter_rooms:
     input:
-        rooms=rules.ingest.output.rooms,
-        architecture=rules.ingest.output.architecture,
-        objects=rules.ingest.output.objects,
+        rooms=INGEST.replace("{table}", "rooms"),
+        architecture=INGEST.replace("{table}", "architecture"),
+        objects=INGEST.replace("{table}", "objects"),
+        counts=CATEGORY_COUNTS,
     output:
-        rooms="results/filter/rooms.parquet",
-        report="results/filter/report.parquet",
-        counts="results/filter/rule_counts.tsv",
+        rooms=FILTER_ROOMS,
+        report=FILTER_SHARD_REPORT,
     params:
-        settings=stage_json("filter", "shards"),
+        config=keys("filter"),
     log:
-        "logs/filter_rooms/filter_rooms.log",
+        "logs/filter_rooms/{shard}.log",
     benchmark:
-        "benchmarks/filter_rooms/filter_rooms.tsv"
+        "benchmarks/filter_rooms/{shard}.tsv"
+    conda:
+        ENV
     shell:
-        "planit filter --config-json {params.settings:q} --ingest results/ingest --out results/filter 2> {log}"
+        "planit filter --config-json {params.config:q} --rooms {input.rooms} --architecture {input.architecture} "
+        "--objects {input.objects} --counts {input.counts} --out-rooms {output.rooms} --out-report {output.report} 2> {log}"
+
+
+rule filter_report:
+    input:
+        reports=shards_of(FILTER_SHARD_REPORT),
+    output:
+        report=FILTER_REPORT,
+        counts=RULE_COUNTS,
+    params:
+        reports=repeat("--report", "reports"),
+    log:
+        "logs/filter_report/filter_report.log",
+    conda:
+        ENV
+    shell:
+        "planit filter-report {params.reports} --out-report {output.report} --out-counts {output.counts} > {log} 2>&1"

@@ -1,87 +1,131 @@
-# Training graphs: dataset statistics (gather), per-shard refinement, gathered tables, scores, report.
+# Training graphs of any corpus: statistics (per-shard map, then gather), per-shard refinement, gathered tables,
+# scores and the graph report.
+
+
+rule shard_statistics:
+    input:
+        nodes=RAW.replace("{table}", "nodes"),
+        edges=RAW.replace("{table}", "edges"),
+    output:
+        counts=PARTIAL,
+        candidates=CANDIDATES,
+    params:
+        config=keys("refine.hub_min_size_ratio", "refine.chain_min_length", "refine.chain_size_ratio",
+                    "refine.chain_collinearity"),
+    log:
+        "logs/shard_statistics/{corpus}-{shard}.log",
+    conda:
+        ENV
+    shell:
+        "planit shard-stats --config-json {params.config:q} --nodes {input.nodes} --edges {input.edges} "
+        "--out-counts {output.counts} --out-candidates {output.candidates} 2> {log}"
 
 
 rule graph_statistics:
     input:
-        nodes=expand("results/graphs/raw/nodes-{shard}.parquet", shard=SHARDS),
-        edges=expand("results/graphs/raw/edges-{shard}.parquet", shard=SHARDS),
+        partial=shards_of(PARTIAL),
+        nodes=shards_of(RAW, table="nodes"),
     output:
-        cooccurrence="results/graphs/stats/cooccurrence.parquet",
-        relations="results/graphs/stats/relations.parquet",
-        hub_patterns="results/graphs/stats/hub_patterns.parquet",
-        category_sizes="results/graphs/stats/category_sizes.parquet",
+        **{name: STATS.replace("{name}", name) for name in STAT_TABLES},
     params:
-        settings=stage_json("refine", "shards"),
+        config=keys("refine.hub_min_pattern_count"),
+        partial=repeat("--partial", "partial"),
+        nodes=repeat("--nodes", "nodes"),
     log:
-        "logs/graph_statistics/graph_statistics.log",
+        "logs/graph_statistics/{corpus}.log",
     benchmark:
-        "benchmarks/graph_statistics/graph_statistics.tsv"
+        "benchmarks/graph_statistics/{corpus}.tsv"
+    conda:
+        ENV
     shell:
-        "planit graph-stats --config-json {params.settings:q} --raw results/graphs/raw "
-        "--out results/graphs/stats 2> {log}"
+        "planit graph-stats --config-json {params.config:q} {params.partial} {params.nodes} "
+        "--out-cooccurrence {output.cooccurrence} --out-relations {output.relations} "
+        "--out-hub-patterns {output.hub_patterns} --out-category-sizes {output.category_sizes} 2> {log}"
 
 
 rule refine_graphs:
     input:
-        nodes="results/graphs/raw/nodes-{shard}.parquet",
-        edges="results/graphs/raw/edges-{shard}.parquet",
-        stats=rules.graph_statistics.output,
+        nodes=RAW.replace("{table}", "nodes"),
+        edges=RAW.replace("{table}", "edges"),
+        candidates=CANDIDATES,
+        relations=STATS.replace("{name}", "relations"),
+        hub_patterns=STATS.replace("{name}", "hub_patterns"),
+        category_sizes=STATS.replace("{name}", "category_sizes"),
     output:
-        nodes="results/graphs/final/nodes-{shard}.parquet",
-        edges="results/graphs/final/edges-{shard}.parquet",
-        superstructures="results/graphs/final/superstructures-{shard}.parquet",
-        summary="results/graphs/final/summary-{shard}.json",
+        nodes=FINAL.replace("{table}", "nodes"),
+        edges=FINAL.replace("{table}", "edges"),
+        superstructures=FINAL.replace("{table}", "superstructures"),
+        summary=FINAL_SUMMARY,
     params:
-        settings=stage_json("refine"),
+        config=keys("refine.pruning", "refine.thresholds", "refine.connectivity"),
     log:
-        "logs/refine_graphs/{shard}.log",
+        "logs/refine_graphs/{corpus}-{shard}.log",
     benchmark:
-        "benchmarks/refine_graphs/{shard}.tsv"
+        "benchmarks/refine_graphs/{corpus}-{shard}.tsv"
+    conda:
+        ENV
     shell:
-        "planit refine --shard {wildcards.shard} --config-json {params.settings:q} --raw results/graphs/raw "
-        "--stats results/graphs/stats --out results/graphs/final 2> {log}"
+        "planit refine --shard {wildcards.shard} --config-json {params.config:q} --nodes {input.nodes} "
+        "--edges {input.edges} --candidates {input.candidates} --relations {input.relations} "
+        "--hub-patterns {input.hub_patterns} --category-sizes {input.category_sizes} --out-nodes {output.nodes} "
+        "--out-edges {output.edges} --out-superstructures {output.superstructures} --out-summary {output.summary} 2> {log}"
 
 
 rule gather_graphs:
     input:
-        expand("results/graphs/final/{table}-{shard}.parquet", table=["nodes", "edges", "superstructures"], shard=SHARDS),
+        nodes=shards_of(FINAL, table="nodes"),
+        edges=shards_of(FINAL, table="edges"),
+        superstructures=shards_of(FINAL, table="superstructures"),
     output:
-        nodes="results/graphs/nodes.parquet",
-        edges="results/graphs/edges.parquet",
-        superstructures="results/graphs/superstructures.parquet",
+        nodes=GATHERED.replace("{table}", "nodes"),
+        edges=GATHERED.replace("{table}", "edges"),
+        superstructures=GATHERED.replace("{table}", "superstructures"),
     params:
-        settings=stage_json("shards"),
+        nodes=repeat("--nodes", "nodes"),
+        edges=repeat("--edges", "edges"),
+        superstructures=repeat("--superstructures", "superstructures"),
     log:
-        "logs/gather_graphs/gather_graphs.log",
+        "logs/gather_graphs/{corpus}.log",
+    conda:
+        ENV
     shell:
-        "planit gather-graphs --config-json {params.settings:q} --final results/graphs/final --out results/graphs 2> {log}"
+        "planit gather-graphs {params.nodes} {params.edges} {params.superstructures} --out-nodes {output.nodes} "
+        "--out-edges {output.edges} --out-superstructures {output.superstructures} 2> {log}"
 
 
 rule score_superstructures:
     input:
-        ground_truth=rules.ingest.output.ground_truth,
-        nodes=rules.gather_graphs.output.nodes,
-        superstructures=rules.gather_graphs.output.superstructures,
+        nodes=GATHERED.replace("{table}", "nodes"),
+        superstructures=GATHERED.replace("{table}", "superstructures"),
+        ground_truth=get_corpus_ground_truth,
     output:
-        metrics="results/metrics/superstructures.json",
+        metrics=METRICS.replace("{name}", "superstructures"),
     params:
-        settings=stage_json("source", "refine"),
+        ground_truth=repeat("--ground-truth", "ground_truth"),
     log:
-        "logs/score_superstructures/score_superstructures.log",
+        "logs/score_superstructures/{corpus}.log",
+    conda:
+        ENV
     shell:
-        "planit score-graphs --config-json {params.settings:q} --ingest results/ingest --graphs results/graphs "
-        "--out {output.metrics} 2> {log}"
+        "planit score-graphs --nodes {input.nodes} --superstructures {input.superstructures} {params.ground_truth} "
+        "--out {output.metrics} > {log} 2>&1"
 
 
 rule graph_report:
     input:
-        rules.gather_graphs.output,
+        nodes=GATHERED.replace("{table}", "nodes"),
+        edges=GATHERED.replace("{table}", "edges"),
+        superstructures=GATHERED.replace("{table}", "superstructures"),
     output:
-        table1="results/graphs/report/table1.csv",
-        pruning="results/graphs/report/pruning.csv",
-        relations="results/graphs/report/relations.csv",
-        plot=report("results/graphs/report/graph_stats.png", caption="../docs/report/graph_stats.rst", category="Graphs"),
+        table1=REPORT.replace("{name}", "table1.csv"),
+        pruning=REPORT.replace("{name}", "pruning.csv"),
+        relations=REPORT.replace("{name}", "relations.csv"),
+        plot=report(REPORT.replace("{name}", "graph_stats.png"), caption="../docs/report/graph_stats.rst", category="Graphs"),
     log:
-        "logs/graph_report/graph_report.log",
+        "logs/graph_report/{corpus}.log",
+    conda:
+        ENV
     shell:
-        "planit stats results/graphs --out results/graphs/report > {log} 2>&1"
+        "planit graph-report --nodes {input.nodes} --edges {input.edges} --superstructures {input.superstructures} "
+        "--out-table1 {output.table1} --out-pruning {output.pruning} --out-relations {output.relations} "
+        "--out-plot {output.plot} 2> {log}"

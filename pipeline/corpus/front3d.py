@@ -20,9 +20,11 @@ import numpy as np
 import shapely
 from shapely.ops import unary_union
 
-from ..geometry import meshes as M
 from ..geometry.polygon import (make_ccw, merge_collinear, polygon_segments, segment_distances, segment_interval,
                                 signed_area)
+
+from ..errors import InputError
+from .rows import box_model_row, model_row, opening_row, room_row, wall_rows
 
 log = logging.getLogger("planit.front3d")
 
@@ -32,7 +34,7 @@ CM_EXTENT = 5.0  # m: a model whose extent exceeds this is in centimetres
 OPENINGS = {"Door": "door", "Hole": "door", "Window": "window", "BayWindow": "window"}
 
 
-class HouseError(ValueError):
+class HouseError(InputError):
     """A house file that cannot be parsed; the message names the file and the field."""
 
 
@@ -183,12 +185,7 @@ def wall_mesh_coverage(segs: np.ndarray, footprints: list[np.ndarray], tolerance
     return np.array([line.intersection(band).length / line.length if line.length else 0.0 for line in lines])
 
 
-def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, report: Counter) -> dict[str, list]:
-    """Rooms of one house as canonical rows: {'rooms', 'architecture', 'objects', 'models'}.
-
-    Rooms without a Floor mesh, of an unmapped type or without valid furniture are skipped (counted in
-    ``report`` with the reason). A malformed house raises HouseError naming the file and field.
-    """
+def _load_house(file: Path) -> dict:
     try:
         house = json.loads(Path(file).read_text())
     except (OSError, json.JSONDecodeError) as exc:
@@ -198,70 +195,79 @@ def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, 
             raise HouseError(f"{file}: missing field '{key}'")
     if "room" not in house["scene"]:
         raise HouseError(f"{file}: missing field 'scene.room'")
+    return house
+
+
+def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, report: Counter) -> dict[str, list]:
+    """Rooms of one house as canonical rows: {'rooms', 'architecture', 'objects', 'models'}.
+
+    Rooms without a Floor mesh, of an unmapped type or without valid furniture are skipped (counted in
+    ``report`` with the reason). A malformed house raises HouseError naming the file and field.
+    """
+    house = _load_house(file)
     furniture = {f["uid"]: f for f in house["furniture"] if "uid" in f}
     arch_meshes = {m["uid"]: m for m in house["mesh"] if "uid" in m}
     out = {"rooms": [], "architecture": [], "objects": [], "models": {}}
     for room in house["scene"]["room"]:
         rtype_src = room.get("type", "")
-        room_id = f"{house['uid']}_{room.get('instanceid', rtype_src)}"
         rtype = cfg["room_types"].get(rtype_src)
         if rtype is None:
             report[("room", "skipped", f"room type '{rtype_src}' not mapped")] += 1
             continue
         children = room.get("children", [])
         room_meshes = [arch_meshes[c["ref"]] for c in children if c.get("ref") in arch_meshes]
-        floors = [m for m in room_meshes if m.get("type") == "Floor"]
-        if not floors:
-            report[("room", "skipped", "no Floor mesh")] += 1
-            continue
         valid = [c for c in children if c.get("ref") in furniture and furniture[c["ref"]].get("valid")
                  and furniture[c["ref"]].get("jid")]
-        if not valid:
-            report[("room", "skipped", "no valid furniture")] += 1
+        rid = f"{house['uid']}_{room.get('instanceid', rtype_src)}"
+        rows, why = _room(rid, rtype, rtype_src, room_meshes, valid, furniture, catalogue, meshes, out["models"], cfg,
+                          report, file)
+        if rows is None:
+            report[("room", "skipped", why)] += 1
             continue
-        try:
-            outline = _outline(floors, file)
-        except ValueError as exc:
-            report[("room", "skipped", str(exc))] += 1
-            continue
-        floor_z = min(float(_mesh_xyz(m, file)[:, 2].min()) for m in floors)
-        ceilings = [xyz[:, 2].max() for xyz in (_mesh_xyz(m, file) for m in room_meshes if m.get("type") == "Ceiling")
-                    if len(xyz)]
-        height = float(max(ceilings)) - floor_z if ceilings else cfg["default_height"]
-        segs = polygon_segments(outline)
-        walls = []
-        for i, s in enumerate(segs):
-            walls.append({"room_id": room_id, "element_id": f"wall_{i}", "kind": "wall", "x0": s[0][0], "y0": s[0][1],
-                          "x1": s[1][0], "y1": s[1][1], "z0": 0.0, "z1": height, "thickness": cfg["wall_thickness"],
-                          "wall_id": None})
-        out["architecture"] += walls + _openings(room_id, room_meshes, segs, floor_z, cfg, file)
-        objects = []
-        for c in valid:
-            row = _object(room_id, len(objects), furniture[c["ref"]], c, catalogue, meshes, out["models"], floor_z,
-                          category_map(cfg, rtype), report)
-            if row is not None:
-                objects.append(row)
-        floor = shapely.Polygon(outline).buffer(cfg["outside_tolerance"])
-        inside = [o for o in objects if floor.contains(shapely.Point(o["cx"], o["cy"]))]
-        if len(inside) < len(objects):
-            report[("object", "dropped", "centre outside its room's floor outline")] += len(objects) - len(inside)
-        objects = [dict(o, object_id=f"obj_{k:02d}") for k, o in enumerate(inside)]
-        if not objects:
-            report[("room", "skipped", "no furniture with a mesh or box inside the floor outline")] += 1
-            out["architecture"] = [a for a in out["architecture"] if a["room_id"] != room_id]
-            continue
-        xs, ys = outline[:, 0], outline[:, 1]
-        out["rooms"].append({"room_id": room_id, "source": "front3d", "room_type": rtype, "source_room_type": rtype_src,
-                             "floor_x": xs.tolist(), "floor_y": ys.tolist(), "height": height,
-                             "floor_area": signed_area(outline), "extent_x": float(np.ptp(xs)),
-                             "extent_y": float(np.ptp(ys)), "n_objects": len(objects), "shard": None})
-        out["objects"] += objects
+        for k in ("rooms", "architecture", "objects"):
+            out[k] += rows[k]
         report[("room", "read", rtype)] += 1
-        backed = wall_mesh_coverage(segs, [_mesh_xyz(m, file)[:, :2] for m in room_meshes if m.get("type") == "WallInner"],
-                                    cfg["wall_mesh_tolerance"]) >= cfg["wall_mesh_min_coverage"]
-        report[("wall", "backed", "a WallInner mesh runs along it")] += int(backed.sum())
-        report[("wall", "open", "no WallInner mesh along it (open to a neighbour, or the mesh is another room's)")] += int((~backed).sum())
     return out
+
+
+def _room(rid, rtype, rtype_src, room_meshes, valid, furniture, catalogue, meshes, models, cfg, report, file):
+    """Canonical rows of one room, or (None, reason) for a room that cannot be read."""
+    floors = [m for m in room_meshes if m.get("type") == "Floor"]
+    if not floors:
+        return None, "no Floor mesh"
+    if not valid:
+        return None, "no valid furniture"
+    try:
+        outline = _outline(floors, file)
+    except ValueError as exc:
+        return None, str(exc)
+    floor_z = min(float(_mesh_xyz(m, file)[:, 2].min()) for m in floors)
+    ceilings = [xyz[:, 2].max() for xyz in (_mesh_xyz(m, file) for m in room_meshes if m.get("type") == "Ceiling")
+                if len(xyz)]
+    height = float(max(ceilings)) - floor_z if ceilings else cfg["default_height"]
+    cmap = category_map(cfg, rtype)
+    objects = [o for o in (_object(rid, k, furniture[c["ref"]], c, catalogue, meshes, models, floor_z, cmap, report)
+                           for k, c in enumerate(valid)) if o is not None]
+    floor = shapely.Polygon(outline).buffer(cfg["outside_tolerance"])
+    inside = [o for o in objects if floor.contains(shapely.Point(o["cx"], o["cy"]))]
+    if len(inside) < len(objects):
+        report[("object", "dropped", "centre outside its room's floor outline")] += len(objects) - len(inside)
+    if not inside:
+        return None, "no furniture with a mesh or box inside the floor outline"
+    segs = polygon_segments(outline)
+    _report_walls(segs, room_meshes, cfg, report, file)
+    return {"rooms": [room_row(rid, "front3d", rtype, rtype_src, outline, height, len(inside))],
+            "architecture": wall_rows(rid, outline, height, cfg["wall_thickness"])
+            + _openings(rid, room_meshes, segs, floor_z, cfg, file),
+            "objects": [dict(o, object_id=f"obj_{k:02d}") for k, o in enumerate(inside)]}, ""
+
+
+def _report_walls(segs: np.ndarray, room_meshes: list[dict], cfg: dict, report: Counter, file: Path) -> None:
+    """Count each outline wall as backed by a WallInner mesh or open."""
+    backed = wall_mesh_coverage(segs, [_mesh_xyz(m, file)[:, :2] for m in room_meshes if m.get("type") == "WallInner"],
+                                cfg["wall_mesh_tolerance"]) >= cfg["wall_mesh_min_coverage"]
+    report[("wall", "backed", "a WallInner mesh runs along it")] += int(backed.sum())
+    report[("wall", "open", "no WallInner mesh along it (open to a neighbour, or the mesh is another room's)")] += int((~backed).sum())
 
 
 def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: float, cfg: dict,
@@ -282,11 +288,9 @@ def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: 
         p0, p1 = segment_interval(xyz[:, :2], segs[w])
         if np.linalg.norm(p1 - p0) < cfg["opening_min_width"]:
             continue
-        k = counts[kind]
+        rows.append(opening_row(room_id, kind, counts[kind], p0, p1, xyz[:, 2].min() - floor_z, xyz[:, 2].max() - floor_z,
+                                f"wall_{w}"))
         counts[kind] += 1
-        rows.append({"room_id": room_id, "element_id": f"{kind}_{k}", "kind": kind, "x0": p0[0], "y0": p0[1],
-                     "x1": p1[0], "y1": p1[1], "z0": float(xyz[:, 2].min() - floor_z), "z1": float(xyz[:, 2].max() - floor_z),
-                     "thickness": None, "wall_id": f"wall_{w}"})
     return rows
 
 
@@ -306,21 +310,13 @@ def _object(room_id, k, furn, child, catalogue, meshes, models, floor_z, cmap, r
     if jid not in models:
         mesh = meshes.get(jid)
         if mesh is not None:
-            v, f, path = mesh
-            kind = "mesh"
+            models[jid] = model_row(jid, category, "front3d", mesh[0], mesh[1], "mesh", mesh[2])
         elif jid in catalogue.box:
-            lo, hi = catalogue.box[jid]
-            v, f = M.box(hi - lo, (lo + hi) / 2)
-            path, kind = None, "box_fallback"
+            models[jid] = box_model_row(jid, category, "front3d", *catalogue.box[jid])
             report[("model", "fallback", "box from Models.csv (no raw_model.obj)")] += 1
         else:
             report[("object", "dropped", "no mesh and no box for its model")] += 1
             return None
-        lo, hi = v.min(axis=0), v.max(axis=0)
-        models[jid] = {"model_id": jid, "category": category, "source": "front3d",
-                       "vertices": np.asarray(v, np.float32).ravel().tolist(), "faces": np.asarray(f, np.int32).ravel().tolist(),
-                       "mesh_kind": kind, "mesh_path": path, "min_x": lo[0], "min_y": lo[1], "min_z": lo[2],
-                       "max_x": hi[0], "max_y": hi[1], "max_z": hi[2]}
     m = models[jid]
     try:
         pos = np.asarray(child["pos"], float) @ WORLD.T

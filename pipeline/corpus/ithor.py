@@ -19,14 +19,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry import meshes as M
-from ..geometry.polygon import segment_distances, segment_interval
+from ..geometry.polygon import polygon_segments, segment_distances, segment_interval
+from .rows import box_model_row, opening_row, room_row, wall_rows
 
 GROUPS = {"bedrooms": "bedroom", "living_rooms": "living", "kitchens": "kitchen", "bathrooms": "bathroom"}
 PARTS = {"Drawer", "Cabinet", "Shelf", "StoveBurner", "StoveKnob", "Faucet", "SinkBasin", "BathtubBasin", "ShowerHead"}
 HIDDEN_IN = {"Drawer", "Cabinet"}  # things inside these are stored away, not placed
 WALL_MOUNTED = {"LightSwitch", "Painting", "Poster", "Mirror", "Blinds", "Curtains", "ShowerDoor", "ShowerGlass",
                 "ShowerCurtain", "TowelHolder", "HandTowelHolder", "ToiletPaperHanger", "Window", "Floor"}
+HEIGHT, WALL_THICKNESS = 2.5, 0.1  # m: the metadata gives neither
 FLOOR_STANDING = 0.01  # m: an object whose bottom is this close to the floor stands on it
 UNITY = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]])  # (x, y, z) Unity -> (x, z, y) right-handed Z-up
 
@@ -69,21 +70,80 @@ def _box(corners: np.ndarray, yaw: float) -> tuple[np.ndarray, np.ndarray]:
     return np.array([mid[0], mid[1], (z.min() + z.max()) / 2]), np.array([(hi - lo)[0] / 2, (hi - lo)[1] / 2, np.ptp(z) / 2])
 
 
+def room_id(group: str, index: int) -> str:
+    return f"ithor_{GROUPS[group]}_{index:02d}"
+
+
 def parse_room(group: str, index: int, objects: list[dict], cfg: dict, report: Counter) -> dict[str, list]:
-    room_type = GROUPS[group]
-    room_id = f"ithor_{room_type}_{index:02d}"
+    """One AI2-THOR room as canonical rows: {'rooms', 'architecture', 'objects', 'models', 'ground_truth'}."""
+    rid, room_type = room_id(group, index), GROUPS[group]
+    out = {"rooms": [], "architecture": [], "objects": [], "models": [], "ground_truth": []}
     floor = next((o for o in objects if o.get("objectType") == "Floor"), None)
     if floor is None:
         report[("room", "skipped", "no Floor object")] += 1
-        return {"rooms": [], "architecture": [], "objects": [], "models": [], "ground_truth": []}
+        return out
     fc = _corners(floor)
     floor_z = float(fc[:, 2].max())
     lo, hi = fc[:, :2].min(axis=0) + cfg["floor_shrink"], fc[:, :2].max(axis=0) - cfg["floor_shrink"]
     outline = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
-    height = 2.5
-    segs = np.stack([outline, np.roll(outline, -1, axis=0)], 1)
-    arch = [{"room_id": room_id, "element_id": f"wall_{i}", "kind": "wall", "x0": s[0][0], "y0": s[0][1], "x1": s[1][0],
-             "y1": s[1][1], "z0": 0.0, "z1": height, "thickness": 0.1, "wall_id": None} for i, s in enumerate(segs)]
+    segs = polygon_segments(outline)
+    out["architecture"] = wall_rows(rid, outline, HEIGHT, WALL_THICKNESS)
+    ids = {}
+    for o in objects:
+        if o.get("objectType") == "Window":
+            c = _corners(o)
+            if c is not None:
+                out["architecture"].append(_window(rid, len(out["architecture"]) - len(segs), c, segs, floor_z))
+            continue
+        row = _object(rid, len(out["objects"]), o, objects, outline, floor_z, report)
+        if row is not None:
+            ids[o["objectId"]] = row["object_id"]
+            out["objects"].append(row)
+            out["models"].append(box_model_row(row["model_id"], row["category"], "ithor", [-row["hx"], -row["hy"], 0.0],
+                                               [row["hx"], row["hy"], 2 * row["hz"]]))
+    out["ground_truth"] = _support_truth(rid, out["objects"], objects, ids, report)
+    out["rooms"].append(room_row(rid, "ithor", room_type, group, outline, HEIGHT, len(out["objects"])))
+    report[("room", "read", room_type)] += 1
+    return out
+
+
+def _object(rid: str, k: int, o: dict, objects: list[dict], outline: np.ndarray, floor_z: float,
+            report: Counter) -> dict | None:
+    """An ``objects`` row for one AI2-THOR object, or None (counted in ``report``) for what is not placed."""
+    t = o.get("objectType")
+    if t in WALL_MOUNTED:
+        if t != "Floor":
+            report[("object", "dropped", "wall-mounted")] += 1
+        return None
+    if t in PARTS:
+        report[("object", "dropped", "part folded into its furniture")] += 1
+        return None
+    by_type = {x["objectId"]: x.get("objectType") for x in objects}
+    if any(by_type.get(p) in HIDDEN_IN for p in o.get("parentReceptacles") or []):
+        report[("object", "dropped", "stored inside a drawer or cabinet")] += 1
+        return None
+    corners = _corners(o)
+    if corners is None:
+        report[("object", "dropped", "no bounding box")] += 1
+        return None
+    corners = corners - [0.0, 0.0, floor_z]
+    yaw = -math.radians(float((o.get("rotation") or {}).get("y", 0.0)))
+    centre, half = _box(corners, yaw)
+    if min(half) <= 1e-3:
+        report[("object", "dropped", "degenerate box")] += 1
+        return None
+    yaw, centre, half = _face_away_from_wall(yaw, centre, half, corners, outline)
+    oid = f"obj_{k:02d}"
+    report[("object", "kept", category(t))] += 1
+    return {"room_id": rid, "object_id": oid, "category": category(t), "model_id": f"{rid}/{oid}",
+            "cx": centre[0], "cy": centre[1], "cz": centre[2], "hx": half[0], "hy": half[1], "hz": half[2], "yaw": yaw,
+            "px": centre[0], "py": centre[1], "pz": centre[2] - half[2], "sx": 1.0, "sy": 1.0, "sz": 1.0,
+            "source_parent_id": None, "_source": o}
+
+
+def _support_truth(rid: str, rows: list[dict], objects: list[dict], ids: dict[str, str], report: Counter) -> list[dict]:
+    """Ground-truth support parents from ``parentReceptacles`` (parts resolve to their furniture); sets each row's
+    ``source_parent_id``."""
     by_id = {o["objectId"]: o for o in objects}
     holder = _holders(objects)
 
@@ -96,60 +156,11 @@ def parse_room(group: str, index: int, objects: list[dict], cfg: dict, report: C
             return oid
         if holder.get(oid) is not None:  # a part belongs to the furniture whose box holds it (a basin: its sink)
             return holder[oid]
-        for p in o.get("parentReceptacles") or []:
-            r = owner(p, depth + 1)
-            if r is not None:
-                return r
-        return None
+        return next((r for p in o.get("parentReceptacles") or [] if (r := owner(p, depth + 1)) is not None), None)
 
-    windows = 0
-    rows, gt, models = [], [], []
-    ids = {}
-    for o in objects:
-        t = o.get("objectType")
-        if t == "Window":
-            c = _corners(o)
-            if c is not None:
-                arch.append(_window(room_id, windows, c, segs, floor_z))
-                windows += 1
-            continue
-        if t in WALL_MOUNTED:
-            if t != "Floor":
-                report[("object", "dropped", "wall-mounted")] += 1
-            continue
-        if t in PARTS:
-            report[("object", "dropped", "part folded into its furniture")] += 1
-            continue
-        parents = o.get("parentReceptacles") or []
-        if any(by_id.get(p, {}).get("objectType") in HIDDEN_IN for p in parents):
-            report[("object", "dropped", "stored inside a drawer or cabinet")] += 1
-            continue
-        corners = _corners(o)
-        if corners is None:
-            report[("object", "dropped", "no bounding box")] += 1
-            continue
-        corners = corners - [0.0, 0.0, floor_z]
-        yaw = -math.radians(float((o.get("rotation") or {}).get("y", 0.0)))
-        centre, half = _box(corners, yaw)
-        if min(half) <= 1e-3:
-            report[("object", "dropped", "degenerate box")] += 1
-            continue
-        yaw, centre, half = _face_away_from_wall(yaw, centre, half, corners, outline)
-        k = len(rows)
-        oid = f"obj_{k:02d}"
-        ids[o["objectId"]] = oid
-        mid = f"{room_id}/{oid}"
-        v, f = M.box(2 * half, (0.0, 0.0, half[2]))
-        models.append({"model_id": mid, "category": category(t), "source": "ithor", "vertices": v.astype(np.float32).ravel().tolist(),
-                       "faces": f.astype(np.int32).ravel().tolist(), "mesh_kind": "box_fallback", "mesh_path": None,
-                       "min_x": -half[0], "min_y": -half[1], "min_z": 0.0, "max_x": half[0], "max_y": half[1], "max_z": 2 * half[2]})
-        rows.append({"room_id": room_id, "object_id": oid, "category": category(t), "model_id": mid,
-                     "cx": centre[0], "cy": centre[1], "cz": centre[2], "hx": half[0], "hy": half[1], "hz": half[2], "yaw": yaw,
-                     "px": centre[0], "py": centre[1], "pz": centre[2] - half[2], "sx": 1.0, "sy": 1.0, "sz": 1.0,
-                     "source_parent_id": None, "_parents": parents})
-        report[("object", "kept", category(t))] += 1
+    gt = []
     for r in rows:
-        parents = r.pop("_parents")
+        parents = r.pop("_source").get("parentReceptacles") or []
         if r["cz"] - r["hz"] <= FLOOR_STANDING and parents:
             # e.g. a chair "in" a desk's receptacle volume: it stands on the floor, PlanIT's support is static support
             report[("object", "kept", "parentReceptacles of a floor-standing object ignored")] += 1
@@ -157,14 +168,9 @@ def parse_room(group: str, index: int, objects: list[dict], cfg: dict, report: C
         parent = next((owner(p) for p in parents if owner(p) in ids), None)
         if parent is not None and ids[parent] != r["object_id"]:
             r["source_parent_id"] = ids[parent]
-            gt.append({"room_id": room_id, "relation": "support", "anchor_id": ids[parent], "target_id": r["object_id"],
+            gt.append({"room_id": rid, "relation": "support", "anchor_id": ids[parent], "target_id": r["object_id"],
                        "direction": None, "group_id": None, "label": None})
-    xs, ys = outline[:, 0], outline[:, 1]
-    room = {"room_id": room_id, "source": "ithor", "room_type": room_type, "source_room_type": group,
-            "floor_x": xs.tolist(), "floor_y": ys.tolist(), "height": height, "floor_area": float(np.ptp(xs) * np.ptp(ys)),
-            "extent_x": float(np.ptp(xs)), "extent_y": float(np.ptp(ys)), "n_objects": len(rows), "shard": None}
-    report[("room", "read", room_type)] += 1
-    return {"rooms": [room], "architecture": arch, "objects": rows, "models": models, "ground_truth": gt}
+    return gt
 
 
 def _holders(objects: list[dict]) -> dict[str, str]:
@@ -204,12 +210,10 @@ def _face_away_from_wall(yaw, centre, half, corners, outline):
     return math.atan2(math.sin(new), math.cos(new)), centre, half
 
 
-def _window(room_id: str, k: int, corners: np.ndarray, segs: np.ndarray, floor_z: float) -> dict:
+def _window(rid: str, k: int, corners: np.ndarray, segs: np.ndarray, floor_z: float) -> dict:
     w = int(np.argmin(segment_distances(corners[:, :2].mean(axis=0), segs)))
     p0, p1 = segment_interval(corners[:, :2], segs[w])
-    return {"room_id": room_id, "element_id": f"window_{k}", "kind": "window", "x0": p0[0], "y0": p0[1], "x1": p1[0],
-            "y1": p1[1], "z0": float(corners[:, 2].min() - floor_z), "z1": float(corners[:, 2].max() - floor_z),
-            "thickness": None, "wall_id": f"wall_{w}"}
+    return opening_row(rid, "window", k, p0, p1, corners[:, 2].min() - floor_z, corners[:, 2].max() - floor_z, f"wall_{w}")
 
 
 def load(cfg: dict) -> tuple[dict, Path]:

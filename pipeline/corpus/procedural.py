@@ -17,6 +17,7 @@ import shapely
 from ..geometry import boxes
 from ..geometry.polygon import inward_normals, polygon_segments, signed_area
 from . import catalog
+from .rows import model_row, opening_row, room_row, wall_rows
 
 ROOM_TYPES = ("bedroom", "living", "office", "bathroom", "kitchen")
 ROOM_SIZE = {  # (min, max) extent in m along each axis
@@ -86,11 +87,7 @@ def build_models(variants: int, seed: int) -> tuple[dict[str, list[Model]], list
             v, f, (w, d, h) = catalog.build_model(name, k, seed)
             mid = catalog.model_id(name, k)
             by_cat.setdefault(name, []).append(Model(mid, name, w, d, h))
-            lo, hi = v.min(axis=0), v.max(axis=0)
-            rows.append({"model_id": mid, "category": name, "source": "procedural",
-                         "vertices": v.astype(np.float32).ravel().tolist(), "faces": f.astype(np.int32).ravel().tolist(),
-                         "mesh_kind": "mesh", "mesh_path": None,
-                         "min_x": lo[0], "min_y": lo[1], "min_z": lo[2], "max_x": hi[0], "max_y": hi[1], "max_z": hi[2]})
+            rows.append(model_row(mid, name, "procedural", v, f))
     return by_cat, rows
 
 
@@ -140,13 +137,9 @@ class RoomBuilder:
         self.outline = np.round(pts, 4)
         self.height = height
         segs = polygon_segments(self.outline)
-        normals = inward_normals(segs)
-        thickness = float(self.rng.uniform(0.1, 0.2))
-        for i, (seg, n) in enumerate(zip(segs, normals)):
+        for i, (seg, n) in enumerate(zip(segs, inward_normals(segs))):
             self.walls.append(Wall(i, seg[0].copy(), seg[1].copy(), n))
-            self.arch.append({"room_id": self.room_id, "element_id": f"wall_{i}", "kind": "wall",
-                              "x0": seg[0][0], "y0": seg[0][1], "x1": seg[1][0], "y1": seg[1][1],
-                              "z0": 0.0, "z1": height, "thickness": thickness, "wall_id": None})
+        self.arch += wall_rows(self.room_id, self.outline, height, float(self.rng.uniform(0.1, 0.2)))
         self._openings()
 
     def _openings(self) -> None:
@@ -169,10 +162,7 @@ class RoomBuilder:
 
     def _opening(self, kind: str, k: int, wall: Wall, s: float, width: float, z0: float, z1: float) -> None:
         p0 = wall.a + wall.dir * s
-        p1 = p0 + wall.dir * width
-        self.arch.append({"room_id": self.room_id, "element_id": f"{kind}_{k}", "kind": kind,
-                          "x0": p0[0], "y0": p0[1], "x1": p1[0], "y1": p1[1], "z0": z0, "z1": z1,
-                          "thickness": None, "wall_id": wall.element_id})
+        self.arch.append(opening_row(self.room_id, kind, k, p0, p0 + wall.dir * width, z0, z1, wall.element_id))
 
     # ------------------------------------------------------------------ objects
     def model(self, category: str, variant: int | None = None) -> Model:
@@ -560,6 +550,10 @@ REQUIRED = {"bedroom": {"bed"}, "living": {"sofa", "armchair"}, "office": {"desk
             "kitchen": {"kitchen_cabinet", "refrigerator", "stove"}, "bathroom": {"toilet", "bathtub", "shower"}}
 
 
+def room_id(room_type: str, index: int) -> str:
+    return f"proc_{room_type}_{index:05d}"
+
+
 def generate_room(index: int, room_type: str, seed: int, models: dict[str, list[Model]],
                   defect_rate: float, l_shape_rate: float) -> RoomBuilder:
     """Generate room ``index`` of ``room_type``; deterministic in ``(seed, room_type, index)``."""
@@ -573,7 +567,7 @@ def generate_room(index: int, room_type: str, seed: int, models: dict[str, list[
     if defect == "room_size":
         size = (6.4, 7.8)
     height = float(rng.uniform(4.3, 5.0)) if defect == "room_height" else float(rng.uniform(2.5, 3.0))
-    r = RoomBuilder(f"proc_{room_type}_{index:05d}", room_type, rng, models, index=index)
+    r = RoomBuilder(room_id(room_type, index), room_type, rng, models, index=index)
     r.make_shell(bool(rng.random() < l_shape_rate), size, height)
     RECIPES[content_type](r)
     for _ in range(8):  # top up sparse rooms with clutter so clean rooms pass the object-count bounds
@@ -613,12 +607,7 @@ def _apply_defect(r: RoomBuilder, defect: str) -> None:
 
 def room_tables(r: RoomBuilder) -> tuple[dict, list[dict], list[dict], list[dict]]:
     """Rows of the canonical tables for one generated room."""
-    poly = r.outline
-    xs, ys = poly[:, 0], poly[:, 1]
-    room = {"room_id": r.room_id, "source": "procedural", "room_type": r.room_type, "source_room_type": r.room_type,
-            "floor_x": xs.tolist(), "floor_y": ys.tolist(), "height": r.height, "floor_area": signed_area(poly),
-            "extent_x": float(xs.max() - xs.min()), "extent_y": float(ys.max() - ys.min()),
-            "n_objects": len(r.objects), "shard": None}
+    room = room_row(r.room_id, "procedural", r.room_type, r.room_type, r.outline, r.height, len(r.objects))
     objs = []
     for o in r.objects:
         objs.append({"room_id": r.room_id, "object_id": o.object_id, "category": o.category, "model_id": o.model.model_id,

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry import meshes as M
-from ..geometry.polygon import signed_area
 from .front3d import WORLD, HouseError, outline_of_triangles
+from .rows import box_model_row, room_row, wall_rows
 
+WALL_THICKNESS = 0.1  # m: house.json gives none
 ROOM_TYPES = {"Bedroom": "bedroom", "Living_Room": "living", "Office": "office", "Kitchen": "kitchen",
               "Bathroom": "bathroom", "Toilet": "bathroom"}
 
@@ -75,10 +75,7 @@ def _room(out, house_id, room, nodes, floor, scale, rtype, categories, report) -
     floor_z = float(v[:, 2].min())
     room_id = f"{house_id}_{room['id']}"
     height = float(room.get("bbox", {}).get("max", [0, 2.7, 0])[1]) * scale - floor_z
-    segs = np.stack([outline, np.roll(outline, -1, axis=0)], 1)
-    out["architecture"] += [{"room_id": room_id, "element_id": f"wall_{i}", "kind": "wall", "x0": s[0][0], "y0": s[0][1],
-                             "x1": s[1][0], "y1": s[1][1], "z0": 0.0, "z1": height, "thickness": 0.1, "wall_id": None}
-                            for i, s in enumerate(segs)]
+    out["architecture"] += wall_rows(room_id, outline, height, WALL_THICKNESS)
     objects = []
     for idx in room.get("nodeIndices", []):
         if idx >= len(nodes):
@@ -101,18 +98,12 @@ def _room(out, house_id, room, nodes, floor, scale, rtype, categories, report) -
             ext = ext[[1, 0, 2]]
         oid = f"obj_{len(objects):02d}"
         mid = f"suncg/{n['modelId']}/{ext[0]:.3f}x{ext[1]:.3f}x{ext[2]:.3f}"
-        bv, bf = M.box(ext, (0.0, 0.0, ext[2] / 2))
-        out["models"].append({"model_id": mid, "category": categories.get(n["modelId"], n["modelId"]), "source": "suncg",
-                              "vertices": bv.astype(np.float32).ravel().tolist(), "faces": bf.astype(np.int32).ravel().tolist(),
-                              "mesh_kind": "box_fallback", "mesh_path": None, "min_x": -ext[0] / 2, "min_y": -ext[1] / 2,
-                              "min_z": 0.0, "max_x": ext[0] / 2, "max_y": ext[1] / 2, "max_z": ext[2]})
+        out["models"].append(box_model_row(mid, categories.get(n["modelId"], n["modelId"]), "suncg",
+                                           [-ext[0] / 2, -ext[1] / 2, 0.0], [ext[0] / 2, ext[1] / 2, ext[2]]))
         objects.append({"room_id": room_id, "object_id": oid, "category": categories.get(n["modelId"], n["modelId"]),
                         "model_id": mid, "cx": c[0], "cy": c[1], "cz": c[2], "hx": ext[0] / 2, "hy": ext[1] / 2,
                         "hz": ext[2] / 2, "yaw": yaw, "px": c[0], "py": c[1], "pz": c[2] - ext[2] / 2, "sx": 1.0, "sy": 1.0,
                         "sz": 1.0, "source_parent_id": None})
-    xs, ys = outline[:, 0], outline[:, 1]
-    out["rooms"].append({"room_id": room_id, "source": "suncg", "room_type": rtype, "source_room_type": ",".join(room.get("roomTypes", [])),
-                         "floor_x": xs.tolist(), "floor_y": ys.tolist(), "height": height, "floor_area": signed_area(outline),
-                         "extent_x": float(np.ptp(xs)), "extent_y": float(np.ptp(ys)), "n_objects": len(objects), "shard": None})
+    out["rooms"].append(room_row(room_id, "suncg", rtype, ",".join(room.get("roomTypes", [])), outline, height, len(objects)))
     out["objects"] += objects
     report[("room", "read", rtype)] += 1

@@ -10,12 +10,13 @@ import warnings
 import numpy as np
 import trimesh
 
+from ..errors import PlanitError
 from .meshes import Mesh, combine
 
 log = logging.getLogger("planit.raycast")
 
 
-class BackendError(RuntimeError):
+class BackendError(PlanitError):
     """The requested ray backend is not available."""
 
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 
-from .superstructures import DIRECTION_PREFERENCE, Chain, Hub, find_chains, hub_candidates, select_hubs
+from .superstructures import DIRECTION_PREFERENCE, Chain, Hub, find_chains, hub_candidates, node_index, select_hubs
 
 ARCHITECTURE_EDGES = ("wall_adjacent", "wall_opposite", "opening")
 UNIQUE_FRONT = ("none", "left-right")
@@ -35,25 +35,19 @@ class Refined:
     repaired: int
 
 
-def node_index(nodes: list[dict]) -> dict[str, dict]:
-    out = {}
-    for n in nodes:
-        n = dict(n)
-        n["diag"] = 2.0 * math.hypot(n["hx"], n["hy"])
-        out[n["node_id"]] = n
-    return out
-
-
-def refine_room(nodes: list[dict], raw_edges: list[dict], stats: Stats, cfg: dict) -> Refined:
-    """Refine one room. ``cfg`` is the ``refine`` config section."""
+def refine_room(nodes: list[dict], raw_edges: list[dict], stats: Stats, cfg: dict,
+                candidates: tuple[list[Chain], list[Hub]] | None = None) -> Refined:
+    """Refine one room. ``cfg`` is the ``refine`` config section; ``candidates`` are the room's chains and hub
+    candidates as the statistics map step found them (computed here when not given)."""
     room_type = nodes[0]["room_type"] if nodes else ""
     idx = node_index(nodes)
     edges = [dict(e, status="kept", rule=None, origin="raw", group_id=None) for e in raw_edges]
-    spatial = [e for e in edges if e["edge_type"] == "spatial"]
-
-    chains = find_chains(idx, spatial, cfg)
-    chain_of = {m: k for k, c in enumerate(chains) for m in c.members}
-    hubs = select_hubs(hub_candidates(idx, spatial, cfg, chain_of), idx, stats.hub_patterns.get(room_type, set()))
+    if candidates is None:
+        spatial = [e for e in edges if e["edge_type"] == "spatial"]
+        chains = find_chains(idx, spatial, cfg)
+        candidates = (chains, hub_candidates(idx, spatial, cfg, {m: k for k, c in enumerate(chains) for m in c.members}))
+    chains, hub_cands = candidates
+    hubs = select_hubs(hub_cands, idx, stats.hub_patterns.get(room_type, set()))
     supers = _mark_superstructures(edges, hubs, chains)
     _resolve_double_edges(edges, idx, stats, room_type)
     _inherit_hub_edges(edges, hubs)

@@ -12,23 +12,27 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from .. import duck
+from .. import duck, tables
 
 ARCH = "('wall_adjacent', 'wall_opposite', 'opening')"
 
 
-def _con(graph_dir: Path) -> duckdb.DuckDBPyConnection:
+def _con(nodes: Path, edges: Path, superstructures: Path) -> duckdb.DuckDBPyConnection:
     con = duck.connect()
-    for name in ("nodes", "edges", "superstructures"):
-        path = Path(graph_dir) / f"{name}.parquet"
-        if not path.exists():
-            raise FileNotFoundError(f"{path}: no such table (run the gather_graphs rule first)")
-        con.execute(f"CREATE VIEW {name} AS SELECT * FROM read_parquet('{path.as_posix()}')")
+    for name, path, schema in (("nodes", nodes, "final_nodes"), ("edges", edges, "final_edges"),
+                               ("superstructures", superstructures, "superstructures")):
+        tables.check(path, schema)
+        con.execute(f"CREATE VIEW {name} AS SELECT * FROM read_parquet('{Path(path).as_posix()}')")
     return con
 
 
-def graph_report(graph_dir: Path) -> dict[str, pd.DataFrame]:
-    con = _con(graph_dir)
+def graph_tables(folder: Path) -> tuple[Path, Path, Path]:
+    """The gathered final graph tables of a corpus folder (``results/graphs/<corpus>``)."""
+    return tuple(Path(folder) / f"{n}.parquet" for n in ("nodes", "edges", "superstructures"))
+
+
+def graph_report(nodes: Path, edges: Path, superstructures: Path) -> dict[str, pd.DataFrame]:
+    con = _con(nodes, edges, superstructures)
     table1 = con.execute("""
         WITH n AS (SELECT room_id, CAST(room_type AS VARCHAR) room_type, count(*) nodes,
                           count(*) FILTER (WHERE kind = 'object') non_wall_nodes FROM nodes GROUP BY ALL),
@@ -74,19 +78,16 @@ def print_report(report: dict[str, pd.DataFrame], stream: TextIO) -> None:
         console.print(t)
 
 
-def write_report(report: dict[str, pd.DataFrame], out_dir: Path) -> list[Path]:
-    """CSV per table and one PNG: edges per node before/after pruning and the pruning shares, per room type."""
+def write_report(report: dict[str, pd.DataFrame], outputs: dict[str, Path]) -> list[Path]:
+    """CSV per table (``outputs[name]``) and one PNG (``outputs['plot']``): edges per node before/after pruning and
+    the pruning shares, per room type. Every file is written atomically."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths = []
     for name, df in report.items():
-        paths.append(out_dir / f"{name}.csv")
-        df.to_csv(paths[-1], index=False)
+        tables.write_csv(outputs[name], df)
     t1, pr = report["table1"], report["pruning"]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
     x = range(len(t1))
@@ -103,18 +104,17 @@ def write_report(report: dict[str, pd.DataFrame], out_dir: Path) -> list[Path]:
     ax2.tick_params(axis="x", rotation=0)
     ax2.legend(fontsize=7, bbox_to_anchor=(1.0, 1.0), loc="upper left")
     fig.tight_layout()
-    paths.append(out_dir / "graph_stats.png")
-    fig.savefig(paths[-1], dpi=110)
+    tables.write_figure(outputs["plot"], fig, dpi=110)
     plt.close(fig)
-    return paths
+    return [Path(outputs[k]) for k in (*report, "plot")]
 
 
 def print_room(graph_dir: Path, room_id: str, stream: TextIO) -> None:
     """One room's graph, readably: nodes, then kept and pruned edges with the deciding rule."""
-    con = _con(graph_dir)
+    con = _con(*graph_tables(graph_dir))
     nodes = con.execute("SELECT * FROM nodes WHERE room_id = ? ORDER BY kind DESC, node_id", [room_id]).df()
     if nodes.empty:
-        raise KeyError(f"room '{room_id}' is not in {graph_dir}/nodes.parquet")
+        raise tables.TableError(f"room '{room_id}' is not in {graph_dir}/nodes.parquet")
     edges = con.execute("SELECT * FROM edges WHERE room_id = ? ORDER BY status, source, target", [room_id]).df()
     console = Console(file=stream, width=160)
     console.print(f"[bold]{room_id}[/bold] ({nodes['room_type'].iloc[0]}): {len(nodes)} nodes, "

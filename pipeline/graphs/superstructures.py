@@ -5,11 +5,22 @@ diagonal), ``cx``, ``cy``; edges are dicts of the ``edges`` table.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass
 
 import numpy as np
 
 DIRECTION_PREFERENCE = ("front", "back", "right", "left")
+
+
+def node_index(nodes: list[dict]) -> dict[str, dict]:
+    """Node rows by id, each with its footprint diagonal ``diag`` added."""
+    out = {}
+    for n in nodes:
+        n = dict(n)
+        n["diag"] = 2.0 * math.hypot(n["hx"], n["hy"])
+        out[n["node_id"]] = n
+    return out
 
 
 def fits_symmetry(symmetry: str, directions: set[str], count: int) -> bool:
@@ -44,7 +55,6 @@ class Chain:
     members: list[str]  # start ... end
     direction: str
     label: str  # adjacent | proximal
-    edges: list[int] = field(default_factory=list)  # indices of the chain's edges
 
 
 def hub_candidates(nodes: dict[str, dict], edges: list[dict], cfg: dict, exclude: dict[str, int] | None = None) -> list[Hub]:
@@ -95,8 +105,8 @@ def find_chains(nodes: dict[str, dict], edges: list[dict], cfg: dict) -> list[Ch
     collinear (unit dot >= ``chain_collinearity``). Ties prefer front > back > right > left.
     """
     lo, hi = cfg["chain_size_ratio"]
-    succ: dict[tuple[str, str], dict[str, list[tuple[str, int]]]] = {}
-    for i, e in enumerate(edges):
+    succ: dict[tuple[str, str], dict[str, list[str]]] = {}
+    for e in edges:
         if e["edge_type"] != "spatial" or e["distance"] not in ("adjacent", "proximal"):
             continue
         a, t = nodes.get(e["source"]), nodes.get(e["target"])
@@ -106,13 +116,13 @@ def find_chains(nodes: dict[str, dict], edges: list[dict], cfg: dict) -> list[Ch
             continue
         if e["distance"] == "proximal" and a["model_id"] != t["model_id"]:
             continue
-        succ.setdefault((e["direction"], e["distance"]), {}).setdefault(a["node_id"], []).append((t["node_id"], i))
+        succ.setdefault((e["direction"], e["distance"]), {}).setdefault(a["node_id"], []).append(t["node_id"])
     candidates = []
     for (direction, label), graph in succ.items():
         for start in sorted(graph):
-            path, used_edges = _longest_walk(start, graph, nodes, cfg["chain_collinearity"])
+            path = _longest_walk(start, graph, nodes, cfg["chain_collinearity"])
             if len(path) >= cfg["chain_min_length"]:
-                candidates.append(Chain(path, direction, label, used_edges))
+                candidates.append(Chain(path, direction, label))
     candidates.sort(key=lambda c: (-len(c.members), DIRECTION_PREFERENCE.index(c.direction), c.label, c.members))
     chosen, used = [], set()
     for c in candidates:
@@ -123,18 +133,18 @@ def find_chains(nodes: dict[str, dict], edges: list[dict], cfg: dict) -> list[Ch
     return chosen
 
 
-def _longest_walk(start: str, graph: dict[str, list[tuple[str, int]]], nodes: dict[str, dict], min_dot: float):
+def _longest_walk(start: str, graph: dict[str, list[str]], nodes: dict[str, dict], min_dot: float) -> list[str]:
     """Longest collinear simple walk from ``start`` (depth-first; chains are short)."""
-    best: tuple[list[str], list[int]] = ([start], [])
+    best = [start]
 
     def pos(n: str) -> np.ndarray:
         return np.array([nodes[n]["cx"], nodes[n]["cy"]])
 
-    def walk(path: list[str], used: list[int], heading: np.ndarray | None) -> None:
+    def walk(path: list[str], heading: np.ndarray | None) -> None:
         nonlocal best
-        if len(path) > len(best[0]):
-            best = (list(path), list(used))
-        for nxt, ei in graph.get(path[-1], []):
+        if len(path) > len(best):
+            best = list(path)
+        for nxt in graph.get(path[-1], []):
             if nxt in path:
                 continue
             step = pos(nxt) - pos(path[-1])
@@ -144,7 +154,7 @@ def _longest_walk(start: str, graph: dict[str, list[tuple[str, int]]], nodes: di
             step = step / norm
             if heading is not None and float(step @ heading) < min_dot:
                 continue
-            walk(path + [nxt], used + [ei], step)
+            walk(path + [nxt], step)
 
-    walk([start], [], None)
+    walk([start], None)
     return best

@@ -1,10 +1,10 @@
-"""Symmetry stage: one functional symmetry type per model (config table first, else detected from the mesh)."""
+"""Symmetry stage (gather per corpus): one functional symmetry type per model. This is the one place where the
+rule "the config table's type for the category first, else the type detected from the mesh" is applied;
+extraction reads the result."""
 from __future__ import annotations
 
 import logging
 from pathlib import Path
-
-import numpy as np
 
 from .. import tables
 from ..config import config_hash
@@ -14,23 +14,25 @@ from ..log import progress
 log = logging.getLogger("planit.symmetry")
 
 
-def model_mesh(row: dict) -> tuple[np.ndarray, np.ndarray]:
-    """(vertices (n, 3), faces (m, 3)) of a ``models`` table row."""
-    v = np.asarray(row["vertices"] if row["vertices"] is not None else [], dtype=float).reshape(-1, 3)
-    f = np.asarray(row["faces"] if row["faces"] is not None else [], dtype=np.int64).reshape(-1, 3)
-    return v, f
+def _unique_models(paths: list[Path]) -> list[dict]:
+    """Model rows of every shard, one per model id (shards of real corpora share models)."""
+    seen, out = set(), []
+    for row in tables.read_many(paths, "models").to_pylist():
+        if row["model_id"] not in seen:
+            seen.add(row["model_id"])
+            out.append(row)
+    return sorted(out, key=lambda r: r["model_id"])
 
 
-def run(config: dict, ingest_dir: str | Path, out_dir: str | Path) -> dict:
-    """Write ``symmetry.parquet`` and ``agreement.json`` (how often detection agrees with the table)."""
+def run(config: dict, models: list[Path], out_table: Path, out_agreement: Path) -> dict:
+    """Write the ``symmetry`` table and ``agreement.json`` (how often detection agrees with the table)."""
     cfg = config["extract"]["symmetry"]
-    models = tables.read(Path(ingest_dir) / "models.parquet", "models").to_pylist()
     rows = []
-    for m in progress(models, desc="symmetry"):
+    for m in progress(_unique_models(models), desc="symmetry"):
         table_value = cfg["table"].get(m["category"])
         detected = None
         if cfg["detect"]:
-            v, f = model_mesh(m)
+            v, f = tables.model_mesh(m)
             detected = symmetry.detect(v, f, cfg["tolerance"], cfg["samples"], seed=config["seed"])
         final = table_value or detected or "none"
         origin = "table" if table_value else ("detected" if detected else "default")
@@ -43,9 +45,7 @@ def run(config: dict, ingest_dir: str | Path, out_dir: str | Path) -> dict:
                "agree": agree, "agreement": round(agree / len(both), 4) if both else None,
                "disagreements": sorted({f"{r['category']}: table {r['table']} / detected {r['detected']}"
                                         for r in both if r["detected"] != r["table"]})}
-    out_dir = Path(out_dir)
-    tables.write(out_dir / "symmetry.parquet", "symmetry", tables.from_rows("symmetry", rows),
-                 {"config_hash": config_hash(cfg)})
-    tables.write_json(out_dir / "agreement.json", summary)
+    tables.write(out_table, "symmetry", tables.from_rows("symmetry", rows), {"config_hash": config_hash(cfg)})
+    tables.write_json(out_agreement, summary)
     log.info("symmetry: %d models, detection agrees with the table on %s of %d", len(rows), summary["agreement"], len(both))
     return summary
