@@ -1,9 +1,7 @@
 # Config validation, every output path (defined here once) and the helpers every rule file uses (no lambdas in rules).
 import json
-import os
 import shlex
 import sys
-from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
@@ -18,15 +16,11 @@ try:  # the CLI's validator: same defaults, and a bad key is named in one line
 except planit_config.ConfigError as exc:
     raise WorkflowError(str(exc)) from None
 
-# Jobs call the `planit` installed beside the Python that runs Snakemake, whether or not a venv is activated
-# (with --sdm conda, the rule's environment comes first on PATH). Each stage sees only the keys its rule passes.
-os.environ["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"
-os.environ["PLANIT_STRICT_KEYS"] = "1"
-# the conda environment's post-deploy script installs this package from here
-os.environ["PLANIT_SOURCE"] = str(Path(workflow.basedir).resolve())
+from pipeline.workflow import prepare_jobs
+
+prepare_jobs(workflow.basedir)  # jobs find the `planit` beside this Python; each sees only its rule's keys
 
 SHARDS = list(range(config["shards"]))
-CORPORA = ["ingested", *sorted(config["corpora"])]
 ENV = "../environment.yml"
 
 
@@ -44,19 +38,18 @@ FILTER_ROOMS = "results/filter/shards/rooms-{shard}.parquet"
 FILTER_SHARD_REPORT = "results/filter/shards/report-{shard}.parquet"
 FILTER_REPORT = "results/filter/report.parquet"
 RULE_COUNTS = "results/filter/rule_counts.tsv"
-GRAPHS = "results/graphs/{corpus}"
-SYMMETRY = GRAPHS + "/symmetry.parquet"
-SYMMETRY_AGREEMENT = GRAPHS + "/symmetry_agreement.json"
-RAW = GRAPHS + "/raw/{table}-{shard}.parquet"
-RAW_SUMMARY = GRAPHS + "/raw/summary-{shard}.json"
-PARTIAL = GRAPHS + "/stats/partial-{shard}.parquet"
-CANDIDATES = GRAPHS + "/stats/candidates-{shard}.parquet"
-STATS = GRAPHS + "/stats/{name}.parquet"
+SYMMETRY = "results/graphs/{corpus}/symmetry.parquet"
+SYMMETRY_AGREEMENT = "results/graphs/{corpus}/symmetry_agreement.json"
+RAW = "results/graphs/{corpus}/raw/{table}-{shard}.parquet"
+RAW_SUMMARY = "results/graphs/{corpus}/raw/summary-{shard}.json"
+PARTIAL = "results/graphs/{corpus}/stats/partial-{shard}.parquet"
+CANDIDATES = "results/graphs/{corpus}/stats/candidates-{shard}.parquet"
+STATS = "results/graphs/{corpus}/stats/{name}.parquet"
 STAT_TABLES = ["cooccurrence", "relations", "hub_patterns", "category_sizes"]
-FINAL = GRAPHS + "/final/{table}-{shard}.parquet"
-FINAL_SUMMARY = GRAPHS + "/final/summary-{shard}.json"
-GATHERED = GRAPHS + "/{table}.parquet"
-REPORT = GRAPHS + "/report/{name}"
+FINAL = "results/graphs/{corpus}/final/{table}-{shard}.parquet"
+FINAL_SUMMARY = "results/graphs/{corpus}/final/summary-{shard}.json"
+GATHERED = "results/graphs/{corpus}/{table}.parquet"
+REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
 
 

@@ -22,6 +22,7 @@ rule ingest_summary:
     input:
         rooms=shards_of(INGEST, table="rooms"),
         objects=shards_of(INGEST, table="objects"),
+        models=shards_of(INGEST, table="models"),
         reports=shards_of(INGEST, table="ingest_report"),
     output:
         counts=CATEGORY_COUNTS,
@@ -29,13 +30,14 @@ rule ingest_summary:
     params:
         rooms=repeat("--rooms", "rooms"),
         objects=repeat("--objects", "objects"),
+        models=repeat("--models", "models"),
         reports=repeat("--report", "reports"),
     log:
         "logs/ingest_summary/ingest_summary.log",
     conda:
         ENV
     shell:
-        "planit ingest-summary {params.rooms} {params.objects} {params.reports} --out-counts {output.counts} "
+        "planit ingest-summary {params.rooms} {params.objects} {params.models} {params.reports} --out-counts {output.counts} "
         "--out-report {output.report} 2> {log}"
 
 

@@ -19,7 +19,8 @@ from pipeline.geometry.raycast import intersector_class
 from pipeline.roomdata import room_inputs
 
 ROOT = Path(__file__).resolve().parents[1]
-SHARED_DATA = ROOT.parent / "shared" / "data"
+# Real sample data (never copied into the repository): PLANIT_SHARED_DATA, by default ../shared/data beside the clone.
+SHARED_DATA = Path(os.environ.get("PLANIT_SHARED_DATA", ROOT.parent / "shared" / "data"))
 
 # Property tests: the default profile is derandomized (every run tries the same 200 cases, so CI is
 # reproducible); HYPOTHESIS_PROFILE=deep searches 5,000 fresh random cases per property.
@@ -103,5 +104,5 @@ def edge(graph, src, dst, edge_type="spatial"):
 def shared_data(sub: str) -> Path:
     path = SHARED_DATA / sub
     if not path.exists():
-        pytest.skip(f"real sample data not found at {path} (a fresh clone has no ../shared; see tests/README)")
+        pytest.skip(f"real sample data not found at {path} (set PLANIT_SHARED_DATA; a fresh clone has no ../shared)")
     return path

@@ -5,14 +5,15 @@ import pytest
 
 from pipeline import config
 from pipeline.corpus import procedural
-from pipeline.filtering import filter_rooms, shard_of
+from pipeline.filtering import category_room_counts, filter_rooms
+from pipeline.shards import shard_of
 from conftest import Room
 
 CFG = config.validate({"filter": {"min_category_rooms": 1}})["filter"]
 
 
 def tables_of(*rooms):
-    room_rows = pd.DataFrame([vars(r.row()) for r in rooms])
+    room_rows = pd.DataFrame([dict(vars(r.row()), shard=k % 3) for k, r in enumerate(rooms)])
     arch = pd.concat([r.walls() for r in rooms], ignore_index=True)
     objs = pd.concat([r.objects_df() for r in rooms], ignore_index=True)
     return room_rows, arch, objs
@@ -28,13 +29,18 @@ def bedroom(room_id="b", height=2.7, size=(4.0, 4.0)):
 
 
 def verdict(*rooms, cfg=CFG):
-    rep = filter_rooms(*tables_of(*rooms), cfg, shards=3)
+    rep = run_filter(*tables_of(*rooms), cfg)
     return {row.room_id: (row.status, row.rule, list(row.rules)) for row in rep.itertuples()}
 
 
-def test_clean_room_is_kept_and_sharded():
-    rep = filter_rooms(*tables_of(bedroom()), CFG, shards=3)
-    assert rep.loc[0, "status"] == "kept" and rep.loc[0, "shard"] == shard_of("b", 3)
+def run_filter(rooms, arch, objs, cfg):
+    """The filter as one shard job runs it: category counts from every room, then the shard's rooms."""
+    return filter_rooms(rooms, arch, objs, cfg, category_room_counts(rooms, objs))
+
+
+def test_clean_room_is_kept_in_its_shard():
+    rep = run_filter(*tables_of(bedroom(), bedroom("c")), CFG)
+    assert (rep["status"] == "kept").all() and rep["shard"].tolist() == [0, 1]
 
 
 def test_each_rule_rejects_with_its_name():
@@ -66,7 +72,7 @@ def test_open_wall_loop_and_rare_category():
     b.objects[1]["category"] = "harp"
     rooms, arch, objs = tables_of(a, b)
     arch.loc[(arch.room_id == "a") & (arch.element_id == "wall_2"), "x1"] -= 0.4
-    rep = filter_rooms(rooms, arch, objs, {**CFG, "min_category_rooms": 2}, shards=1).set_index("room_id")
+    rep = run_filter(rooms, arch, objs, {**CFG, "min_category_rooms": 2}).set_index("room_id")
     assert rep.loc["a", "rule"] == "wall_loop" and "meets no other wall" in rep.loc["a", "detail"]
     assert rep.loc["b", "rule"] == "rare_category" and "harp" in rep.loc["b", "detail"]
 
@@ -90,13 +96,13 @@ def corpus():
     models, _ = procedural.build_models(4, 0)
     rooms = [procedural.generate_room(i, rt, 0, models, 0.25, 0.3) for rt in procedural.ROOM_TYPES for i in range(40)]
     tabs = [procedural.room_tables(r) for r in rooms]
-    return (pd.DataFrame([t[0] for t in tabs]), pd.DataFrame([a for t in tabs for a in t[1]]),
+    return (pd.DataFrame([dict(t[0], shard=0) for t in tabs]), pd.DataFrame([a for t in tabs for a in t[1]]),
             pd.DataFrame([o for t in tabs for o in t[2]]), pd.DataFrame([g for t in tabs for g in t[3]]))
 
 
 def test_filters_catch_every_planted_defect_and_keep_clean_rooms(corpus):
     rooms, arch, objs, gt = corpus
-    rep = filter_rooms(rooms, arch, objs, {**CFG, "min_category_rooms": 2}, shards=2).set_index("room_id")
+    rep = run_filter(rooms, arch, objs, {**CFG, "min_category_rooms": 2}).set_index("room_id")
     defects = gt[gt.relation == "defect"].set_index("room_id")["label"]
     assert len(defects) >= 20 and defects.nunique() == len(procedural.DEFECTS)
     for room_id, rule in defects.items():

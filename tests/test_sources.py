@@ -13,16 +13,23 @@ import shapely
 
 from pipeline import config
 from pipeline.corpus import front3d
+from pipeline.errors import InputError
 from pipeline.stages import ingest
 from conftest import ROOT, shared_data
 
 FIX = Path(__file__).parent / "fixtures"
 
 
+def ingest_outputs(folder: Path, shard: int = 0) -> dict[str, Path]:
+    return {name: folder / f"{name}-{shard}.parquet" for name in ingest.OUTPUTS}
+
+
 def run_ingest(source: str, section: dict, tmp_path) -> dict[str, pd.DataFrame]:
-    cfg = config.validate({"source": source, source: section})
-    ingest.run(cfg, tmp_path / "ingest")
-    return {name: pd.read_parquet(tmp_path / "ingest" / f"{name}.parquet") for name in ingest.OUTPUTS}
+    """One ingest job over the whole source (a single shard)."""
+    cfg = config.validate({"source": source, source: section, "shards": 1})
+    outs = ingest_outputs(tmp_path / "ingest")
+    ingest.run(cfg, 0, outs)
+    return {name: pd.read_parquet(path) for name, path in outs.items()}
 
 
 # ----------------------------------------------------------------------------------------------- 3D-FRONT
@@ -140,9 +147,9 @@ def test_front3d_real_sample_runs_through_refinement(tmp_path):
                           "--configfile", str(tmp_path / "cfg.yaml"), "--cores", "2", "-q"], capture_output=True, text=True,
                          env={"PATH": f"{bin_}:/usr/bin:/bin"}, timeout=900)
     assert out.returncode == 0, out.stderr[-3000:]
-    edges = pd.read_parquet(tmp_path / "results/graphs/edges.parquet")
+    edges = pd.read_parquet(tmp_path / "results/graphs/ingested/edges.parquet")
     assert edges.room_id.nunique() >= 10 and set(edges.status) == {"kept", "pruned"}
-    assert (tmp_path / "results/graphs/report/table1.csv").exists()
+    assert (tmp_path / "results/graphs/ingested/report/table1.csv").exists()
 
 
 # ----------------------------------------------------------------------------------------------- AI2-THOR
@@ -164,16 +171,21 @@ def test_ithor_fixture_room(tmp_path):
 @pytest.mark.slow
 def test_ithor_real_rooms_support_parents_agree(tmp_path):
     pytest.importorskip("procthor", reason="the procthor wheel ships the AI2-THOR rooms")
-    from pipeline.stages import extract, filter as filter_stage, score, symmetry
+    from pipeline.stages import extract_graphs, filter_rooms, ingest_summary, score_extraction, symmetry
 
     cfg = config.load(ROOT / "config/ithor.yaml", json.dumps({"shards": 1, "extract": {"symmetry": {"detect": False}}}))
-    ingest.run(cfg, tmp_path / "ingest")
-    rooms = pd.read_parquet(tmp_path / "ingest/rooms.parquet")
+    t = tmp_path
+    outs = ingest_outputs(t)
+    ingest.run(cfg, 0, outs)
+    rooms = pd.read_parquet(outs["rooms"])
     assert len(rooms) == 120 and Counter(rooms.room_type) == {"bedroom": 30, "living": 30, "kitchen": 30, "bathroom": 30}
-    filter_stage.run(cfg, tmp_path / "ingest", tmp_path / "filter")
-    symmetry.run(cfg, tmp_path / "ingest", tmp_path / "symmetry")
-    extract.run(cfg, 0, tmp_path / "ingest", tmp_path / "filter", tmp_path / "raw", tmp_path / "symmetry/symmetry.parquet")
-    metrics = score.run(cfg, tmp_path / "ingest", tmp_path / "raw", tmp_path / "m.json")
+    ingest_summary.run([outs["rooms"]], [outs["objects"]], [outs["models"]], [outs["ingest_report"]], t / "counts.parquet", t / "rep.parquet")
+    filter_rooms.run(cfg, outs["rooms"], outs["architecture"], outs["objects"], t / "counts.parquet", t / "kept.parquet",
+                     t / "filter.parquet")
+    symmetry.run(cfg, [outs["models"]], t / "sym.parquet", t / "sym.json")
+    extract_graphs.run(cfg, 0, t / "kept.parquet", outs["architecture"], outs["objects"], outs["models"], t / "sym.parquet",
+                       t / "nodes.parquet", t / "edges.parquet", t / "summary.json")
+    metrics = score_extraction.run([t / "nodes.parquet"], [t / "edges.parquet"], [outs["ground_truth"]], t / "m.json")
     assert metrics["supported_objects"] > 1500
     assert metrics["support_parent_recall"] >= 0.95
 
@@ -190,12 +202,12 @@ def test_suncg_fixture_with_room_files(tmp_path):
 
 
 def test_suncg_without_room_files_names_the_missing_file(tmp_path):
-    with pytest.raises(FileNotFoundError, match=r"fr_0rm_0f\.obj not found"):
+    with pytest.raises(InputError, match=r"fr_0rm_0f\.obj not found"):
         run_ingest("suncg", {"houses": str(FIX / "suncg/house")}, tmp_path)
 
 
 @pytest.mark.realdata
 def test_suncg_real_sample_reports_the_missing_architecture(tmp_path):
     sample = shared_data("suncg-sample")
-    with pytest.raises(FileNotFoundError, match=r"00e2eed27fb6b5c911624902888039ee/fr_0rm_0f\.obj not found"):
+    with pytest.raises(InputError, match=r"00e2eed27fb6b5c911624902888039ee/fr_0rm_0f\.obj not found"):
         run_ingest("suncg", {"houses": str(sample / "house.json")}, tmp_path)

@@ -53,7 +53,6 @@ def ingest_procedural(config: dict, shard: int, shards: int) -> dict[str, pa.Tab
     used = {o["model_id"] for o in objs}
     report = Counter({("room", "read", rt): n for rt, n in Counter(r["room_type"] for r in rooms).items()})
     report.update({("category", "found", c): n for c, n in Counter(o["category"] for o in objs).items()})
-    report[("model", "kept", "catalogue models used")] = len(used)
     return _tables(rooms, arch, objs, [m for m in model_rows if m["model_id"] in used], gt,
                    _report_rows("procedural", report), shard)
 
@@ -70,10 +69,10 @@ def ingest_front3d(config: dict, shard: int, shards: int) -> dict[str, pa.Table]
     from ..corpus import front3d
 
     cfg = config["front3d"]
+    files = _house_files(Path(cfg["houses"]), "*.json", "front3d.houses", cfg["max_houses"], shard, shards)
     future = Path(cfg["future"])
     if not future.is_dir():
         raise InputError(f"front3d.future: no such folder '{future}'")
-    files = _house_files(Path(cfg["houses"]), "*.json", "front3d.houses", cfg["max_houses"], shard, shards)
     opt = lambda key: Path(cfg[key]) if cfg[key] else None  # noqa: E731
     catalogue = front3d.Catalogue.load(future, opt("models_csv"), opt("category_csv"), opt("model_info"))
     cache = front3d.MeshCache(future, opt("cache_dir"))
@@ -81,7 +80,8 @@ def ingest_front3d(config: dict, shard: int, shards: int) -> dict[str, pa.Table]
     out = {"rooms": [], "architecture": [], "objects": [], "models": {}}
     for f in progress(files, desc=f"3D-FRONT houses, shard {shard}"):
         _house(front3d.parse_house, (f, catalogue, cache, cfg, report), out, report)
-    report[("model", "kept", f"meshes parsed {cache.parsed}, from cache {cache.hits}")] += len(out["models"])
+    report[("model", "parsed", "OBJ meshes parsed")] += cache.parsed
+    report[("model", "cached", "OBJ meshes read from the cache")] += cache.hits
     return _tables(out["rooms"], out["architecture"], out["objects"], list(out["models"].values()), [],
                    _report_rows("front3d", report), shard)
 

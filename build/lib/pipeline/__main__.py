@@ -1,0 +1,4 @@
+"""``python -m pipeline``: the ``planit`` command line."""
+from .cli import app
+
+app(prog_name="planit")

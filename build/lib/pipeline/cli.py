@@ -1,0 +1,244 @@
+"""The ``planit`` command line: one subcommand per pipeline stage (each Snakemake rule calls one) and ``stats``.
+
+Every stage command takes files, never folders: its inputs and outputs are exactly the rule's ``{input}`` and
+``{output}``. Domain errors (a bad table, config, input file or missing backend) end in one line naming the
+file and field, exit code 2; anything else is a bug and keeps its traceback.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import os
+import sys
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+
+from . import config as config_mod
+from .errors import PlanitError
+from .log import setup
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, help=__doc__, pretty_exceptions_enable=False)
+log = logging.getLogger("planit")
+
+ConfigOpt = typer.Option(None, "--config", "-c", help="YAML config (validated against the package's schema.yaml)")
+JsonOpt = typer.Option(None, "--config-json", help="JSON object merged over the config (the Snakemake rules pass the keys they read)")
+ShardOpt = typer.Option(..., "--shard", help="shard index")
+
+
+def _file(flag: str, help: str = "") -> typer.Option:
+    return typer.Option(..., flag, help=help)
+
+
+def _files(flag: str, help: str = "repeat for every shard") -> typer.Option:
+    return typer.Option(..., flag, help=help)
+
+
+def _fail(message: str) -> None:
+    log.error(message)
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(code=2)
+
+
+def _guard(fn, *args, **kwargs):
+    """Run a stage; a domain error becomes a one-line message and exit code 2."""
+    try:
+        return fn(*args, **kwargs)
+    except PlanitError as exc:
+        _fail(str(exc))
+
+
+def _stage(fn, config: Optional[Path], overrides: Optional[str], *args):
+    """Load and validate the config, then run a stage function on it (guarded). With ``PLANIT_STRICT_KEYS=1`` (the
+    Snakemake rules set it) the stage sees only the keys given in ``--config-json``, so a rule whose params miss a
+    key its stage reads fails loudly instead of silently reading the default."""
+    def run():
+        cfg = config_mod.load(config, overrides)
+        if os.environ.get("PLANIT_STRICT_KEYS") == "1" and overrides:
+            cfg = config_mod.restrict(cfg, json.loads(overrides))
+        return fn(cfg, *args)
+
+    return _guard(run)
+
+
+def _summary(values: dict, skip: tuple[str, ...] = ()) -> None:
+    """One line of key=value pairs: what a stage did."""
+    typer.echo(" ".join(f"{k}={v}" for k, v in values.items() if k not in skip))
+
+
+@app.callback()
+def main(verbose: bool = typer.Option(False, "--verbose", "-v")) -> None:
+    setup(verbose)
+
+
+@app.command()
+def ingest(shard: int = ShardOpt, config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+           rooms: Path = _file("--rooms"), architecture: Path = _file("--architecture"), objects: Path = _file("--objects"),
+           models: Path = _file("--models"), ground_truth: Path = _file("--ground-truth"),
+           report: Path = _file("--report", "the shard's ingest report")) -> None:
+    """Read one shard of the configured source into canonical tables."""
+    from .stages import ingest as stage
+
+    outs = {"rooms": rooms, "architecture": architecture, "objects": objects, "models": models,
+            "ground_truth": ground_truth, "ingest_report": report}
+    _summary(_stage(stage.run, config, config_json, shard, outs))
+
+
+@app.command("ingest-summary")
+def ingest_summary(rooms: List[Path] = _files("--rooms"), objects: List[Path] = _files("--objects"),
+                   report: List[Path] = _files("--report"), out_counts: Path = _file("--out-counts"),
+                   out_report: Path = _file("--out-report")) -> None:
+    """Gather the ingest shards: category counts for the filter, the summed ingest report."""
+    from .stages import ingest_summary as stage
+
+    _summary(_guard(stage.run, rooms, objects, report, out_counts, out_report))
+
+
+@app.command("filter")
+def filter_(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+            rooms: Path = _file("--rooms"), architecture: Path = _file("--architecture"),
+            objects: Path = _file("--objects"), counts: Path = _file("--counts", "category_counts.parquet"),
+            out_rooms: Path = _file("--out-rooms"), out_report: Path = _file("--out-report")) -> None:
+    """Filter one shard's rooms (every rejection has a reason)."""
+    from .stages import filter_rooms as stage
+
+    _summary(_stage(stage.run, config, config_json, rooms, architecture, objects, counts, out_rooms, out_report))
+
+
+@app.command("filter-report")
+def filter_report(report: List[Path] = _files("--report"), out_report: Path = _file("--out-report"),
+                  out_counts: Path = _file("--out-counts", "rule_counts.tsv")) -> None:
+    """Gather the filter reports; print rooms per room type and outcome."""
+    from .stages import filter_report as stage
+
+    typer.echo(_guard(stage.run, report, out_report, out_counts).to_string(index=False))
+
+
+@app.command()
+def symmetry(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+             models: List[Path] = _files("--models"), out_table: Path = _file("--out-table"),
+             out_agreement: Path = _file("--out-agreement")) -> None:
+    """Assign a functional symmetry type to every model (config table, else detected from the mesh)."""
+    from .stages import symmetry as stage
+
+    s = _stage(stage.run, config, config_json, models, out_table, out_agreement)
+    typer.echo(f"models={s['models']} agreement={s['agreement']} ({s['agree']}/{s['compared']})")
+
+
+@app.command()
+def extract(shard: int = ShardOpt, config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+            rooms: Path = _file("--rooms", "the shard's kept rooms"), architecture: Path = _file("--architecture"),
+            objects: Path = _file("--objects"), models: Path = _file("--models"), symmetry: Path = _file("--symmetry"),
+            out_nodes: Path = _file("--out-nodes"), out_edges: Path = _file("--out-edges"),
+            out_summary: Path = _file("--out-summary")) -> None:
+    """Ray-cast one shard's rooms into raw relation graphs (nodes, edges)."""
+    from .stages import extract_graphs as stage
+
+    _summary(_stage(stage.run, config, config_json, shard, rooms, architecture, objects, models, symmetry,
+                    out_nodes, out_edges, out_summary))
+
+
+@app.command("shard-stats")
+def shard_stats(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                nodes: Path = _file("--nodes"), edges: Path = _file("--edges"), out_counts: Path = _file("--out-counts"),
+                out_candidates: Path = _file("--out-candidates")) -> None:
+    """One shard's partial counts and superstructure candidates (the map step of the statistics)."""
+    from .stages import shard_statistics as stage
+
+    _summary(_stage(stage.run, config, config_json, nodes, edges, out_counts, out_candidates))
+
+
+@app.command("graph-stats")
+def graph_stats(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                partial: List[Path] = _files("--partial"), nodes: List[Path] = _files("--nodes"),
+                out_cooccurrence: Path = _file("--out-cooccurrence"), out_relations: Path = _file("--out-relations"),
+                out_hub_patterns: Path = _file("--out-hub-patterns"),
+                out_category_sizes: Path = _file("--out-category-sizes")) -> None:
+    """Dataset-wide statistics: the shards' partial counts summed, hub patterns accepted, category sizes."""
+    from .stages import graph_statistics as stage
+
+    outs = {"cooccurrence": out_cooccurrence, "relations": out_relations, "hub_patterns": out_hub_patterns,
+            "category_sizes": out_category_sizes}
+    _summary(_stage(stage.run, config, config_json, partial, nodes, outs))
+
+
+@app.command()
+def refine(shard: int = ShardOpt, config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+           nodes: Path = _file("--nodes"), edges: Path = _file("--edges"), candidates: Path = _file("--candidates"),
+           relations: Path = _file("--relations"), hub_patterns: Path = _file("--hub-patterns"),
+           category_sizes: Path = _file("--category-sizes"), out_nodes: Path = _file("--out-nodes"),
+           out_edges: Path = _file("--out-edges"), out_superstructures: Path = _file("--out-superstructures"),
+           out_summary: Path = _file("--out-summary")) -> None:
+    """Superstructures, pruning and connectivity repair for one shard's raw graphs."""
+    from .stages import refine_graphs as stage
+
+    stats = {"relations": relations, "hub_patterns": hub_patterns, "category_sizes": category_sizes}
+    outs = {"nodes": out_nodes, "edges": out_edges, "superstructures": out_superstructures, "summary": out_summary}
+    _summary(_stage(stage.run, config, config_json, shard, nodes, edges, candidates, stats, outs), skip=("cyclic_room_ids",))
+
+
+@app.command("gather-graphs")
+def gather_graphs(nodes: List[Path] = _files("--nodes"), edges: List[Path] = _files("--edges"),
+                  superstructures: List[Path] = _files("--superstructures"), out_nodes: Path = _file("--out-nodes"),
+                  out_edges: Path = _file("--out-edges"), out_superstructures: Path = _file("--out-superstructures")) -> None:
+    """Concatenate the refined shards into one nodes, edges and superstructures table."""
+    from .stages import gather_graphs as stage
+
+    outs = {"nodes": out_nodes, "edges": out_edges, "superstructures": out_superstructures}
+    _summary(_guard(stage.run, {"nodes": nodes, "edges": edges, "superstructures": superstructures}, outs))
+
+
+@app.command()
+def score(nodes: List[Path] = _files("--nodes"), edges: List[Path] = _files("--edges"),
+          ground_truth: List[Path] = _files("--ground-truth"), out: Path = _file("--out", "metrics JSON")) -> None:
+    """Score raw graphs against the corpus's ground truth (support parents, intended adjacencies)."""
+    from .stages import score_extraction as stage
+
+    for key, value in _guard(stage.run, nodes, edges, ground_truth, out).items():
+        typer.echo(f"{key}: {value}")
+
+
+@app.command("score-graphs")
+def score_graphs(nodes: Path = _file("--nodes"), superstructures: Path = _file("--superstructures"),
+                 ground_truth: List[Path] = _files("--ground-truth"), out: Path = _file("--out", "metrics JSON")) -> None:
+    """Hub and chain precision / recall against the corpus's ground truth."""
+    from .stages import score_superstructures as stage
+
+    for key, value in _guard(stage.run, nodes, superstructures, ground_truth, out).items():
+        typer.echo(f"{key}: {value}")
+
+
+@app.command("graph-report")
+def graph_report(nodes: Path = _file("--nodes"), edges: Path = _file("--edges"),
+                 superstructures: Path = _file("--superstructures"), out_table1: Path = _file("--out-table1"),
+                 out_pruning: Path = _file("--out-pruning"), out_relations: Path = _file("--out-relations"),
+                 out_plot: Path = _file("--out-plot")) -> None:
+    """Write the graph report: Table 1, pruning by rule, frequent relations (CSV) and a PNG."""
+    from .stages import graph_report as stage
+
+    outs = {"table1": out_table1, "pruning": out_pruning, "relations": out_relations, "plot": out_plot}
+    _summary(_guard(stage.run, nodes, edges, superstructures, outs))
+
+
+@app.command()
+def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, or 'graphs' / a folder of gathered graph tables"),
+          room: Optional[str] = typer.Option(None, "--room", help="print this room's graph")) -> None:
+    """Print a table's schema, row count and per-column summary; for graphs, the per-room-type report. Reads only."""
+    if str(path) == "graphs" and not path.exists():
+        path = Path("results/graphs/ingested")
+    if path.is_dir():
+        from .graphs.report import graph_report as report_of, graph_tables, print_report, print_room
+
+        if room:
+            _guard(print_room, path, room, sys.stdout)
+        else:
+            print_report(_guard(report_of, *graph_tables(path)), sys.stdout)
+        return
+    from .inspect import table_summary
+
+    _guard(table_summary, path, sys.stdout)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    app()

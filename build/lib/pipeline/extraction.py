@@ -1,0 +1,396 @@
+"""Relation-graph extraction for one room (paper §4.3): support, spatial and architecture edges.
+
+A pure function of one room's arrays (:class:`RoomInput`): no file IO. The ray casting runs in one Embree
+scene per room with two layers: the objects' world meshes (support rays) and, below the floor, vertical
+prisms over every object's and wall's floor footprint (the "plan" layer, where the paper's floor-plane
+visibility sweep runs). Support and spatial rays go to Embree in one batch.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+
+from .geometry import meshes, relations
+from .geometry.boxes import SIDE_NORMALS, SIDES, diagonal_2d, rotation
+from .geometry.polygon import inward_normals, merge_collinear, outline_from_loop, segment_distances, signed_area, wall_loop
+from .geometry.raycast import RoomScene
+
+log = logging.getLogger("planit.extract")
+
+PLAN_Z = (-3.0, -2.0)  # z band of the plan layer (below any floor-standing geometry)
+MESH, PLAN = 0, 1  # scene layers
+BOX_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
+POSE_COLUMNS = ["px", "py", "pz", "yaw", "sx", "sy", "sz"]
+PIECE_INSET = 1e-3  # m, rays start this far in from each piece's ends
+FLOOR_EPS = 1e-3  # m, an object whose bottom is this close to the floor (z = 0) stands on it
+
+
+@dataclass
+class RoomInput:
+    """One room as arrays: what extraction needs from the canonical tables."""
+    room_id: str
+    room_type: str
+    height: float
+    outline: np.ndarray  # (k, 2) floor outline
+    wall_ids: list[str]
+    wall_segments: np.ndarray  # (w, 2, 2) inner faces
+    wall_thickness: np.ndarray  # (w,)
+    openings: list[dict]  # element_id, kind, x0, y0, x1, y1, z0, z1
+    object_ids: list[str]
+    categories: list[str]
+    model_ids: list[str]
+    boxes: np.ndarray  # (n, 7) BOX_COLUMNS
+    poses: np.ndarray  # (n, 7) POSE_COLUMNS
+
+
+@dataclass
+class RoomGraph:
+    nodes: list[dict] = field(default_factory=list)
+    edges: list[dict] = field(default_factory=list)
+    skipped: list[tuple[str, str]] = field(default_factory=list)  # (node id, reason)
+    rays: int = 0
+    support_cycles: int = 0
+
+
+@dataclass
+class Walls:
+    """Merged wall segments of a room in loop order (inner faces, counter-clockwise)."""
+    ids: list[str]
+    a: np.ndarray  # (w, 2) start points
+    b: np.ndarray  # (w, 2) end points
+    normal: np.ndarray  # (w, 2) into the room
+    thickness: np.ndarray
+    height: float
+
+    @property
+    def length(self) -> np.ndarray:
+        return np.linalg.norm(self.b - self.a, axis=1)
+
+    @property
+    def dir(self) -> np.ndarray:
+        return (self.b - self.a) / self.length[:, None]
+
+
+def merge_walls(segs: np.ndarray, ids: list[str], thick: np.ndarray, height: float, tol: float = 1e-3) -> Walls:
+    """Order wall segments along their loop, make it counter-clockwise and merge collinear neighbours.
+
+    A merged wall keeps the id of the original wall at its start. Raises ValueError for an open loop.
+    """
+    segs = np.asarray(segs, float).reshape(-1, 2, 2)
+    thick = np.where(np.isfinite(thick), thick, 0.1)
+    closed, why, order = wall_loop(segs, tol)
+    if not closed:
+        raise ValueError(f"walls do not form a closed loop: {why}")
+    oriented = [(segs[o], o) if o >= 0 else (segs[-o - 1][::-1], -o - 1) for o in order]
+    if signed_area(outline_from_loop(segs, order)) < 0:
+        oriented = [(s[::-1], k) for s, k in oriented[::-1]]
+    start = {tuple(np.round(s[0], 6)): k for s, k in oriented}
+    outline = merge_collinear(np.array([s[0] for s, _ in oriented]))
+    keys = [start.get(tuple(np.round(p, 6))) for p in outline]
+    names = [ids[k] if k is not None else f"wall_m{i}" for i, k in enumerate(keys)]
+    thickness = np.array([thick[k] if k is not None else float(np.median(thick)) for k in keys])
+    nxt = np.roll(outline, -1, axis=0)
+    return Walls(names, outline, nxt, inward_normals(np.stack([outline, nxt], 1)), thickness, height)
+
+
+def wall_footprints(w: Walls) -> np.ndarray:
+    """(w, 4, 2) counter-clockwise footprints of the walls, behind their inner faces."""
+    back = -w.normal * w.thickness[:, None]
+    return np.stack([w.a, w.b, w.b + back, w.a + back], 1)[:, ::-1]
+
+
+def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) -> RoomGraph:
+    """Raw relation graph of one room.
+
+    ``mesh_of(model_id) -> (vertices, faces) | None`` in model space; ``symmetry_of(category, model_id) ->
+    (symmetry, origin)``; ``cfg`` is the ``extract`` config section; ``intersector`` a trimesh ray class.
+    """
+    g = RoomGraph()
+    walls = merge_walls(room.wall_segments, room.wall_ids, room.wall_thickness, room.height)
+    keep, parts = _usable_objects(g, room, mesh_of)
+    ids = [room.object_ids[k] for k in keep]
+    cats = [room.categories[k] for k in keep]
+    models = [room.model_ids[k] for k in keep]
+    b = room.boxes[keep].reshape(-1, 7)
+    n, n_walls = len(ids), len(walls.ids)
+    obj_fp, wall_fp = relations.footprints(b), wall_footprints(walls)
+    all_fp = np.concatenate([obj_fp, wall_fp])
+    plan = meshes.prisms(all_fp, *PLAN_Z)
+    per_prism = meshes.faces_per_prism(4)
+    scene = RoomScene(parts + [plan], list(range(n)) + [0], [MESH] * n + [PLAN], intersector)
+    scene.owner[-len(plan[1]):] = np.repeat(np.arange(n + n_walls), per_prism)  # one owner per prism
+
+    # rays: support grid under every object, then the visibility sweep of every anchor side
+    sc = cfg["support"]
+    raised = np.flatnonzero(b[:, 2] - b[:, 5] > FLOOR_EPS)  # nothing lies under the floor: only raised objects cast
+    s_orig, s_dir, s_obj, cell = relations.support_rays(b[raised], sc["grid"], sc["start_offset"])
+    s_obj = raised[s_obj]
+    cell = np.zeros(n) if not len(raised) else np.bincount(raised, weights=cell, minlength=n)
+    sym = [symmetry_of(c, m) for c, m in zip(cats, models)]
+    volume = np.prod(2 * b[:, 3:6], axis=1)
+    # support first (the sweep's groups depend on tiers): nearest mesh of another object below each grid point
+    reach = sc["start_offset"] + sc["max_distance"]
+    first_owner, first_dist = scene.first_accepted(
+        s_orig, s_dir, lambda r, own, lay: (lay == MESH) & (own != s_obj[r]), max_dist=reach)
+    if sc["inside_box_contact"]:
+        # grid points whose ray finds nothing within reach but that lie in another object's box rest in or on
+        # the smallest such box (box-only sources, whose boxes reach above their support surface: cushions on
+        # beds, things in fridges); a face level with the object's own bottom hides behind the bottom itself,
+        # so the point just below the bottom is tested too
+        miss = first_dist > reach
+        owner_in, _ = relations.containing_box(s_orig[miss], b, s_obj[miss], volume)
+        below = s_orig[miss] - [0.0, 0.0, sc["start_offset"] + 1e-3]
+        owner_in = np.where(owner_in >= 0, owner_in, relations.containing_box(below, b, s_obj[miss], volume)[0])
+        first_owner[miss] = np.where(owner_in >= 0, owner_in, first_owner[miss])
+        first_dist[miss] = np.where(owner_in >= 0, 0.0, first_dist[miss])
+    footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
+    parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
+    if sc["inside_box_contact"] and len(raised):  # raised, nothing below: held from around (hung in a slab)?
+        loose = raised[parent[raised] < 0]
+        held = relations.holding_box(b, loose)
+        parent[loose] = np.where(held >= 0, held, parent[loose])
+        area[loose] = np.where(held >= 0, footprint[loose], area[loose])
+    parent, cycles = relations.break_support_cycles(parent, footprint)
+    area[parent < 0] = 0.0
+    g.support_cycles = len(cycles)
+    tier = relations.tiers(parent)
+    g.rays += len(s_orig)
+
+    for k in range(n):
+        g.nodes.append({"room_id": room.room_id, "node_id": ids[k], "kind": "object", "category": cats[k],
+                        "model_id": models[k], "symmetry": sym[k][0], "symmetry_origin": sym[k][1], "tier": int(tier[k]),
+                        "parent_id": ids[parent[k]] if parent[k] >= 0 else None,
+                        **dict(zip(BOX_COLUMNS, map(float, b[k]))), "length": None})
+        if parent[k] >= 0:
+            g.edges.append(_edge(room.room_id, ids[parent[k]], ids[k], "support", support_area=float(area[k])))
+    _wall_nodes(g, room.room_id, walls)
+    radial = np.array([s[0] == "radial" for s in sym], bool)
+    group = np.concatenate([np.where(tier <= 1, 0, parent + 1), np.zeros(n_walls, int)])  # who sees whom
+    g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
+    _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
+    return g
+
+
+def _usable_objects(g: RoomGraph, room: RoomInput, mesh_of) -> tuple[list[int], list]:
+    """Indices and world meshes of objects with a finite, non-degenerate box and mesh, centred inside the room;
+    the rest are skipped with a reason."""
+    outline = shapely.Polygon(room.outline).buffer(0.05)
+    inside = shapely.contains_xy(outline, room.boxes[:, 0], room.boxes[:, 1]) if len(room.boxes) else np.zeros(0, bool)
+    finite = np.isfinite(room.boxes).all(axis=1) & np.isfinite(room.poses).all(axis=1)
+    sized = room.boxes[:, 3:6].min(axis=1) > 1e-4 if len(room.boxes) else np.zeros(0, bool)
+    keep, local = [], []
+    for k, oid in enumerate(room.object_ids):
+        if not (finite[k] and sized[k]):
+            g.skipped.append((oid, "zero-size or non-finite box"))
+            continue
+        if not inside[k]:
+            g.skipped.append((oid, "centre outside the room outline"))
+            continue
+        mesh = mesh_of(room.model_ids[k])
+        if mesh is None or len(mesh[1]) == 0 or not np.isfinite(mesh[0]).all():
+            g.skipped.append((oid, f"model {room.model_ids[k]}: missing or degenerate mesh"))
+            continue
+        keep.append(k)
+        local.append(mesh)
+    if not keep:
+        return keep, []
+    # all model -> world transforms in one pass
+    counts = np.array([len(v) for v, _ in local])
+    pose = np.repeat(room.poses[keep], counts, axis=0)
+    v = np.concatenate([v for v, _ in local]) * pose[:, 4:7]
+    c, s = np.cos(pose[:, 3]), np.sin(pose[:, 3])
+    world = np.column_stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1], v[:, 2]]) + pose[:, 0:3]
+    parts = []
+    for (_, f), vw, p in zip(local, np.split(world, np.cumsum(counts)[:-1]), room.poses[keep]):
+        parts.append((vw, f[:, ::-1] if np.prod(p[4:7]) < 0 else f))  # mirrored: keep faces outward
+    return keep, parts
+
+
+def _wall_nodes(g: RoomGraph, room_id: str, walls: Walls) -> None:
+    for w in range(len(walls.ids)):
+        mid = (walls.a[w] + walls.b[w]) / 2
+        g.nodes.append({"room_id": room_id, "node_id": walls.ids[w], "kind": "wall", "category": "wall", "model_id": None,
+                        "symmetry": "none", "symmetry_origin": "architecture", "tier": 0, "parent_id": None,
+                        "cx": float(mid[0]), "cy": float(mid[1]), "cz": walls.height / 2,
+                        "hx": float(walls.length[w] / 2), "hy": float(walls.thickness[w] / 2), "hz": walls.height / 2,
+                        "yaw": _yaw_facing(walls.normal[w]), "length": float(walls.length[w])})
+
+
+def _yaw_facing(normal) -> float:
+    return math.atan2(normal[1], normal[0]) - math.pi / 2
+
+
+def anchor_sides(b: np.ndarray, walls: Walls, sp: dict) -> dict[str, np.ndarray]:
+    """Every anchor side as arrays: 4 per object (front, back, left, right), the inner face per wall."""
+    n = len(b)
+    r = rotation(b[:, 6])  # (n, 2, 2)
+    normal = np.einsum("nij,sj->nsi", r, SIDE_NORMALS).reshape(-1, 2)
+    tangent = np.stack([normal[:, 1], -normal[:, 0]], 1)  # to the right when looking out of the side
+    along_y = np.tile(SIDE_NORMALS[:, 1] != 0, n)
+    hx, hy = np.repeat(b[:, 3], 4), np.repeat(b[:, 4], 4)
+    half_depth = np.where(along_y, hy, hx)
+    half_len = np.where(along_y, hx, hy)
+    centre = np.repeat(b[:, :2], 4, axis=0) + normal * half_depth[:, None]
+    inset = np.minimum(sp["inset_fraction"] * 2 * half_depth, sp["inset_max"])
+    w = len(walls.ids)
+    return {
+        "owner": np.concatenate([np.repeat(np.arange(n), 4), n + np.arange(w)]),
+        "side": np.concatenate([np.tile(np.arange(4), n), np.zeros(w, int)]),
+        "centre": np.concatenate([centre, (walls.a + walls.b) / 2]),
+        "tangent": np.concatenate([tangent, walls.dir]),
+        "normal": np.concatenate([normal, walls.normal]),
+        "half": np.concatenate([half_len, walls.length / 2]),
+        "inset": np.concatenate([inset, np.minimum(sp["inset_fraction"] * walls.thickness, sp["inset_max"])]),
+    }
+
+
+def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Split every side at the projected endpoints of the footprints it may see (same group, not itself,
+    not wholly behind its ray origins). Returns ``piece_side (p,)``, ``starts (p,)``, ``ends (p,)``."""
+    owners = sides["owner"]
+    o = len(all_fp)
+    rel = all_fp[None, :, :, :] - sides["centre"][:, None, None, :]  # (S, O, 4, 2)
+    t = np.einsum("sokj,sj->sok", rel, sides["tangent"])
+    d = np.einsum("sokj,sj->sok", rel, sides["normal"])
+    lo, hi = t.min(axis=2), t.max(axis=2)
+    half = sides["half"][:, None]
+    live = ((group[None, :] == group[owners][:, None]) & (np.arange(o)[None, :] != owners[:, None])
+            & (d.max(axis=2) > -sides["inset"][:, None]) & (hi > -half) & (lo < half))
+    cuts = np.concatenate([-half, half, np.where(live, np.clip(lo, -half, half), np.nan),
+                           np.where(live, np.clip(hi, -half, half), np.nan)], axis=1)
+    cuts = np.sort(cuts, axis=1)  # NaN sort last
+    starts, ends = cuts[:, :-1], cuts[:, 1:]
+    valid = np.isfinite(ends) & (ends - starts > 1e-6)
+    side_idx = np.broadcast_to(np.arange(len(owners))[:, None], starts.shape)
+    return side_idx[valid], starts[valid], ends[valid]
+
+
+def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg) -> int:
+    """Sweep every anchor side and add the visible spatial edges. Returns the number of rays cast."""
+    n, n_walls = len(b), len(walls.ids)
+    total = n + n_walls
+    sp = cfg["spatial"]
+    sides = anchor_sides(b, walls, sp)
+    piece_side, starts, ends = sweep(sides, all_fp, group)
+    pos, ray_piece = relations.piece_rays(starts, ends, PIECE_INSET)
+    ray_side = piece_side[ray_piece]
+    xy = sides["centre"][ray_side] + pos[:, None] * sides["tangent"][ray_side] - sides["normal"][ray_side] * sides["inset"][ray_side, None]
+    origins = np.column_stack([xy, np.full(len(pos), sum(PLAN_Z) / 2)])
+    dirs = np.column_stack([sides["normal"][ray_side], np.zeros(len(pos))])
+    anchor = sides["owner"][ray_side]
+    # supported anchors only see siblings on the same parent: their rays stop beyond the parent's footprint
+    diag = np.concatenate([diagonal_2d(b[:, 3], b[:, 4]), np.zeros(n_walls)])  # walls: the target's diagonal decides
+    reach_of_group = np.concatenate([[np.inf], 2 * diag[:n]])  # group g > 0 lives on object g - 1
+    reach = sides["inset"][ray_side] + reach_of_group[group[anchor]]
+    hit_owner, hit_dist = scene.first_accepted(
+        origins, dirs, lambda r, own, lay: (lay == PLAN) & (own != anchor[r]) & (group[own] == group[anchor[r]]),
+        max_dist=reach)
+    pr = hit_dist.reshape(-1, 2)  # per piece: the nearer of its two rays
+    pick = np.argmin(pr, axis=1)
+    p_owner = hit_owner.reshape(-1, 2)[np.arange(len(pr)), pick]
+    p_dist = pr[np.arange(len(pr)), pick]
+    ok = (p_owner >= 0) & (p_owner < n)  # pieces that reach an object (walls only occlude)
+    contained = _contained_pairs(all_fp[:n], group[:n], sp["contain_fraction"])
+    if not ok.any() and not contained:
+        return len(origins)
+    key = piece_side[ok] * total + p_owner[ok]
+    uniq, inv = np.unique(key, return_inverse=True)
+    vis = np.bincount(inv, weights=(ends - starts)[ok], minlength=len(uniq))
+    gap = np.full(len(uniq), np.inf)
+    np.minimum.at(gap, inv, p_dist[ok])
+    u_side, u_target = uniq // total, uniq % total
+    gap -= sides["inset"][u_side]
+    proj = np.einsum("mkj,mj->mk", all_fp[u_target], sides["tangent"][u_side])
+    target_share = np.minimum(vis / np.maximum(np.ptp(proj, axis=1), 1e-9), 1.0)
+    anchor_share = np.minimum(vis / (2 * sides["half"][u_side]), 1.0)
+    score = np.maximum(target_share, anchor_share)
+    u_anchor, u_sidx = sides["owner"][u_side], sides["side"][u_side]
+    side_scores = np.zeros((total, total, 4))
+    side_scores[u_anchor, u_target, u_sidx] = score
+    # best qualifying side per (anchor, target): highest visibility, then smallest gap
+    cand = np.flatnonzero(score >= sp["min_visibility"])
+    cand = cand[np.lexsort((gap[cand], -score[cand], u_target[cand], u_anchor[cand]))]
+    pairs = u_anchor[cand] * total + u_target[cand]
+    unique_pairs, first = np.unique(pairs, return_index=True)
+    best = dict(zip(unique_pairs.tolist(), cand[first].tolist()))
+    for a, t in contained:
+        best.setdefault(a * total + t, -1)
+    u_label = relations.distance_labels(gap, np.maximum(diag[u_anchor], diag[u_target]), cfg["distance"])
+    for pair in sorted(best):
+        a, t = divmod(pair, total)
+        i = best[pair]
+        is_wall = a >= n
+        if i < 0:  # target mostly inside the anchor's footprint, seen by no ray
+            direction, gap_i, tv, av, label = "front", 0.0, 1.0, 1.0, "adjacent"
+        else:
+            direction = "front" if is_wall or radial[a] else SIDES[u_sidx[i]]
+            gap_i, tv, av = float(gap[i]), float(target_share[i]), float(anchor_share[i])
+            label = "adjacent" if (a, t) in contained else str(u_label[i])
+        sc = side_scores[a, t]
+        src = walls.ids[a - n] if is_wall else ids[a]
+        g.edges.append(_edge(room_id, src, ids[t], "spatial", direction, label, gap=gap_i, target_visibility=tv,
+                             anchor_visibility=av, score_front=float(sc[0]), score_back=float(sc[1]),
+                             score_left=float(sc[2]), score_right=float(sc[3])))
+    return len(origins)
+
+
+def _contained_pairs(fp: np.ndarray, group: np.ndarray, fraction: float) -> set[tuple[int, int]]:
+    """(anchor, target) pairs of one group where at least ``fraction`` of the target's footprint lies in the anchor's."""
+    n = len(fp)
+    if n < 2:
+        return set()
+    lo, hi = fp.min(axis=1), fp.max(axis=1)
+    touch = np.all((lo[:, None] < hi[None, :]) & (lo[None, :] < hi[:, None]), axis=2)
+    i, j = np.nonzero(touch & (group[:, None] == group[None, :]) & ~np.eye(n, dtype=bool))
+    if not len(i):
+        return set()
+    polys = shapely.polygons(fp)
+    inter = shapely.area(shapely.intersection(polys[i], polys[j]))
+    frac = inter / np.maximum(shapely.area(polys[j]), 1e-12)
+    sel = frac >= fraction
+    return set(zip(i[sel].tolist(), j[sel].tolist()))
+
+
+def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings: list[dict], cfg: dict) -> None:
+    """Wall loop (adjacent, with the corner angle), walls facing each other, doors and windows on their wall."""
+    w = len(walls.ids)
+    d = walls.dir
+    for i in range(w):
+        j = (i + 1) % w
+        turn = math.atan2(d[i][0] * d[j][1] - d[i][1] * d[j][0], float(d[i] @ d[j]))
+        angle = math.pi - turn  # interior angle at the shared corner
+        g.edges.append(_edge(room_id, walls.ids[i], walls.ids[j], "wall_adjacent", "right", "adjacent", angle=angle, gap=0.0))
+        g.edges.append(_edge(room_id, walls.ids[j], walls.ids[i], "wall_adjacent", "left", "adjacent", angle=angle, gap=0.0))
+    for i in range(w):
+        for j in range(w):
+            if i == j or abs(i - j) in (1, w - 1) or walls.normal[i] @ walls.normal[j] > -cfg["facing_min_cos"]:
+                continue
+            dist = float((walls.a[j] - walls.a[i]) @ walls.normal[i])
+            t = np.sort([(walls.a[j] - walls.a[i]) @ d[i], (walls.b[j] - walls.a[i]) @ d[i]])
+            overlap = min(t[1], walls.length[i]) - max(t[0], 0.0)
+            if dist > 0 and overlap >= cfg["facing_min_overlap"] * min(walls.length[i], walls.length[j]):
+                g.edges.append(_edge(room_id, walls.ids[i], walls.ids[j], "wall_opposite", "front", "distant", gap=dist))
+    segments = np.stack([walls.a, walls.b], axis=1)
+    for o in openings:
+        mid = np.array([(o["x0"] + o["x1"]) / 2, (o["y0"] + o["y1"]) / 2])
+        dist = segment_distances(mid, segments)
+        wi = int(np.argmin(dist))
+        if dist[wi] > cfg["opening_tolerance"]:
+            g.skipped.append((o["element_id"], "opening lies on no wall of the room"))
+            continue
+        width = float(math.hypot(o["x1"] - o["x0"], o["y1"] - o["y0"]))
+        g.nodes.append({"room_id": room_id, "node_id": o["element_id"], "kind": o["kind"], "category": o["kind"],
+                        "model_id": None, "symmetry": "none", "symmetry_origin": "architecture", "tier": 0, "parent_id": None,
+                        "cx": float(mid[0]), "cy": float(mid[1]), "cz": float((o["z0"] + o["z1"]) / 2), "hx": width / 2,
+                        "hy": float(walls.thickness[wi] / 2), "hz": float((o["z1"] - o["z0"]) / 2),
+                        "yaw": _yaw_facing(walls.normal[wi]), "length": width})
+        g.edges.append(_edge(room_id, walls.ids[wi], o["element_id"], "opening", "front", "adjacent", gap=0.0))
+
+
+def _edge(room_id, src, dst, edge_type, direction=None, distance=None, **extra) -> dict:
+    return {"room_id": room_id, "source": src, "target": dst, "edge_type": edge_type, "direction": direction,
+            "distance": distance, **extra}

@@ -1,0 +1,72 @@
+"""Oriented boxes: footprints, projections, overlaps. Vectorised over ``n`` boxes.
+
+A box is ``(cx, cy, cz, hx, hy, hz, yaw)``: centre, half extents in the local frame (x right,
+y front, z up) and yaw (counter-clockwise about +Z).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+# local-frame outward unit normals of the four vertical sides
+SIDES = ("front", "back", "left", "right")
+SIDE_NORMALS = np.array([[0.0, 1.0], [0.0, -1.0], [-1.0, 0.0], [1.0, 0.0]])
+
+
+def rotation(yaw) -> np.ndarray:
+    """``(..., 2, 2)`` rotation matrices local -> world."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+def footprint_corners(cx, cy, hx, hy, yaw) -> np.ndarray:
+    """``(n, 4, 2)`` world corners of the floor footprints, counter-clockwise."""
+    cx, cy, hx, hy, yaw = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (cx, cy, hx, hy, yaw))
+    local = np.stack([np.stack([-hx, -hy], -1), np.stack([hx, -hy], -1),
+                      np.stack([hx, hy], -1), np.stack([-hx, hy], -1)], 1)  # (n, 4, 2)
+    world = np.einsum("nij,nkj->nki", rotation(yaw), local)
+    return world + np.stack([cx, cy], -1)[:, None, :]
+
+
+def diagonal_2d(hx, hy) -> np.ndarray:
+    """Footprint diagonal length."""
+    return 2.0 * np.hypot(hx, hy)
+
+
+def _axes(yaw: np.ndarray) -> np.ndarray:
+    r = rotation(yaw)  # (n, 2, 2): columns are local x and y in world
+    return np.stack([r[..., 0], r[..., 1]], 1)  # (n, 2 axes, 2)
+
+
+def footprint_overlap(corners_a: np.ndarray, yaw_a: np.ndarray, corners_b: np.ndarray, yaw_b: np.ndarray) -> np.ndarray:
+    """Separating-axis overlap depth of footprint pairs (``<= 0``: disjoint), shape ``(n,)``."""
+    axes = np.concatenate([_axes(yaw_a), _axes(yaw_b)], axis=1)  # (n, 4, 2)
+    pa = np.einsum("nkj,naj->nak", corners_a, axes)
+    pb = np.einsum("nkj,naj->nak", corners_b, axes)
+    overlap = np.minimum(pa.max(-1), pb.max(-1)) - np.maximum(pa.min(-1), pb.min(-1))
+    return overlap.min(axis=1)
+
+
+def penetration_depths(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n)`` interpenetration depth of every box pair (0 where they do not overlap).
+
+    ``boxes`` is ``(n, 7)``. Depth is the smallest overlap over the separating axes of the two
+    footprints and the vertical axis: how far one box must move to clear the other.
+    """
+    b = np.asarray(boxes, dtype=float).reshape(-1, 7)
+    n = len(b)
+    out = np.zeros((n, n))
+    if n < 2:
+        return out
+    i, j = np.triu_indices(n, 1)
+    corners = footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
+    plan = footprint_overlap(corners[i], b[i, 6], corners[j], b[j, 6])
+    zo = np.minimum(b[i, 2] + b[i, 5], b[j, 2] + b[j, 5]) - np.maximum(b[i, 2] - b[i, 5], b[j, 2] - b[j, 5])
+    depth = np.clip(np.minimum(plan, zo), 0.0, None)
+    out[i, j] = depth
+    out[j, i] = depth
+    return out
+
+
+def to_local(points: np.ndarray, cx: float, cy: float, yaw: float) -> np.ndarray:
+    """World ``(..., 2)`` points into a box's local floor frame."""
+    return (np.asarray(points, dtype=float) - [cx, cy]) @ rotation(yaw)

@@ -1,0 +1,191 @@
+"""The geometric predicates of relation extraction, shared by every stage that checks relations.
+
+Pure functions over NumPy arrays: distance labels, support-ray grids and parent choice, the
+visibility sweep's pieces and per-target visibility.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
+
+DISTANCES = ("adjacent", "proximal", "distant")
+
+
+def distance_labels(gap, max_diag, cfg: dict) -> np.ndarray:
+    """adjacent / proximal / distant for gaps (m) between objects whose larger footprint diagonal is ``max_diag``.
+
+    adjacent: gap <= min(adjacent_abs, adjacent_rel * max_diag); proximal: gap <= max(proximal_abs,
+    proximal_rel * max_diag); distant otherwise (paper §4.3).
+    """
+    gap, max_diag = np.broadcast_arrays(np.asarray(gap, float), np.asarray(max_diag, float))
+    adj = np.minimum(cfg["adjacent_abs"], cfg["adjacent_rel"] * max_diag)
+    prox = np.maximum(cfg["proximal_abs"], cfg["proximal_rel"] * max_diag)
+    return np.where(gap <= adj, "adjacent", np.where(gap <= prox, "proximal", "distant"))
+
+
+# ------------------------------------------------------------------------------------------- support
+def support_rays(boxes: np.ndarray, grid: int, start_offset: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Downward rays from a ``grid x grid`` lattice of cell centres under each box.
+
+    Returns ``origins (n*g*g, 3)``, ``directions``, ``obj (n*g*g,)`` (the box each ray belongs to) and
+    ``cell_area (n,)`` in m^2.
+    """
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    n = len(b)
+    u = (np.arange(grid) + 0.5) / grid * 2.0 - 1.0  # cell centres in [-1, 1]
+    gx, gy = np.meshgrid(u, u, indexing="ij")
+    local = np.stack([gx.ravel(), gy.ravel()], 1)  # (g*g, 2)
+    xy = local[None] * b[:, None, 3:5]  # scale by half extents
+    world = np.einsum("nij,nkj->nki", rotation(b[:, 6]), xy) + b[:, None, 0:2]
+    z = (b[:, 2] - b[:, 5] + start_offset)[:, None].repeat(grid * grid, 1)
+    origins = np.concatenate([world, z[..., None]], axis=2).reshape(-1, 3)
+    directions = np.tile([0.0, 0.0, -1.0], (len(origins), 1))
+    obj = np.repeat(np.arange(n), grid * grid)
+    cell_area = (2 * b[:, 3]) * (2 * b[:, 4]) / (grid * grid)
+    return origins, directions, obj, cell_area
+
+
+def choose_parents(obj: np.ndarray, hit_owner: np.ndarray, hit_dist: np.ndarray, cell_area: np.ndarray,
+                   reach: float, size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Parent per object: the object under it with the largest supporting area within ``reach``.
+
+    ``obj``/``hit_owner``/``hit_dist`` are per ray (nearest hit other than the ray's own object, -1 / inf if
+    none). Ties go to the larger object (``size``). Returns ``parent (n,)`` (-1: floor) and ``area (n,)`` m^2.
+    """
+    n = len(cell_area)
+    if n == 0:
+        return np.zeros(0, np.int64), np.zeros(0)
+    ok = (hit_owner >= 0) & (hit_dist <= reach)
+    counts = np.zeros((n, n))
+    np.add.at(counts, (obj[ok], hit_owner[ok]), 1.0)
+    score = counts + 1e-9 * (counts > 0) * size[None, :] / max(float(size.max()), 1e-12)
+    parent = np.where(counts.max(axis=1) > 0, score.argmax(axis=1), -1)
+    area = np.where(parent >= 0, counts[np.arange(n), np.maximum(parent, 0)] * cell_area, 0.0)
+    return parent, area
+
+
+def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volume: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each point, the box (other than ``own``) that contains it with its top nearest above the point
+    (the surface it most likely rests on; ties to the smaller box); -1 where none.
+
+    ``points (k, 3)``, ``boxes (n, 7)``, ``own (k,)`` box index to ignore per point. Returns the box index and
+    a (k, n) containment mask.
+    """
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    if not len(points) or not len(b):
+        return np.full(len(points), -1, dtype=np.int64), np.zeros((len(points), len(b)), bool)
+    rel = points[:, None, :2] - b[None, :, :2]  # (k, n, 2)
+    c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
+    lx = rel[..., 0] * c + rel[..., 1] * s
+    ly = -rel[..., 0] * s + rel[..., 1] * c
+    inside = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (np.abs(points[:, None, 2] - b[:, 2]) <= b[:, 5])
+    inside[np.arange(len(points)), own] = False
+    top = b[:, 2] + b[:, 5]
+    score = np.where(inside, (top[None, :] - points[:, None, 2]) + 1e-6 * volume[None, :] / max(volume.max(), 1e-12), np.inf)
+    best = np.argmin(score, axis=1)
+    return np.where(np.isfinite(score[np.arange(len(points)), best]), best, -1), inside
+
+
+def holding_box(boxes: np.ndarray, candidates: np.ndarray) -> np.ndarray:
+    """For each candidate box, the box that holds it from around: its footprint contains the candidate's
+    centre and its vertical span starts above the candidate's bottom and overlaps it (a sink hung in a
+    counter slab, a ladle through a holder). The lowest such box wins; -1 where none."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    out = np.full(len(candidates), -1, dtype=np.int64)
+    for i, k in enumerate(candidates):
+        rel = b[k, :2] - b[:, :2]
+        c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
+        lx, ly = rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c
+        bottom = b[:, 2] - b[:, 5]
+        k_bottom, k_top = b[k, 2] - b[k, 5], b[k, 2] + b[k, 5]
+        ok = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (bottom > k_bottom) & (bottom < k_top)
+        ok[k] = False
+        if ok.any():
+            out[i] = int(np.flatnonzero(ok)[np.argmin(bottom[ok])])
+    return out
+
+
+def break_support_cycles(parent: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
+    """Un-parent the largest object of every support cycle. Returns the new parents and the cycles found."""
+    parent = parent.copy()
+    cycles = []
+    state = np.zeros(len(parent), dtype=np.int8)  # 0 new, 1 on the current path, 2 done
+    for start in range(len(parent)):
+        path, node = [], start
+        while node >= 0 and state[node] == 0:
+            state[node] = 1
+            path.append(node)
+            node = parent[node]
+        if node >= 0 and state[node] == 1:  # closed a cycle
+            cycle = path[path.index(node):]
+            cycles.append(cycle)
+            parent[max(cycle, key=lambda k: size[k])] = -1
+        for p in path:
+            state[p] = 2
+    return parent, cycles
+
+
+def tiers(parent: np.ndarray) -> np.ndarray:
+    """1 for objects on the floor, 1 + the parent's tier otherwise (parents must be acyclic)."""
+    tier = np.zeros(len(parent), dtype=np.int32)
+
+    def depth(k: int) -> int:
+        if tier[k] == 0:
+            tier[k] = 1 if parent[k] < 0 else depth(parent[k]) + 1
+        return int(tier[k])
+
+    for k in range(len(parent)):
+        depth(k)
+    return tier
+
+
+# ------------------------------------------------------------------------------------------- visibility
+def box_sides(box) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray, float, float]]:
+    """The four vertical sides of a box: (name, centre (2,), tangent (2,), outward normal (2,), half length,
+    depth of the box along the normal)."""
+    cx, cy, _, hx, hy, _, yaw = box
+    r = rotation(yaw)
+    out = []
+    for name, n_local in zip(SIDES, SIDE_NORMALS):
+        n = r @ n_local
+        t = np.array([n[1], -n[0]])  # right-hand tangent when looking out of the side
+        half_depth, half_len = (hy, hx) if n_local[1] != 0 else (hx, hy)
+        out.append((name, np.array([cx, cy]) + n * half_depth, t, n, float(half_len), float(2 * half_depth)))
+    return out
+
+
+def sweep_pieces(centre: np.ndarray, tangent: np.ndarray, normal: np.ndarray, half_len: float,
+                 corners: np.ndarray, behind: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Split an anchor side at the projected endpoints of candidate footprints.
+
+    ``corners`` is ``(k, 4, 2)``; candidates wholly behind the ray origins (more than ``behind`` behind the
+    side) or outside the side's span are ignored. Returns ``starts (p,)``, ``ends (p,)`` along the tangent
+    (relative to ``centre``) and ``proj (k, 2)`` each candidate's projected interval.
+    """
+    rel = corners - centre
+    t = rel @ tangent
+    d = rel @ normal
+    proj = np.stack([t.min(axis=1), t.max(axis=1)], 1)
+    live = (d.max(axis=1) > -behind) & (proj[:, 1] > -half_len) & (proj[:, 0] < half_len)
+    cuts = np.clip(proj[live].ravel(), -half_len, half_len)
+    bounds = np.unique(np.concatenate([[-half_len, half_len], cuts]))
+    starts, ends = bounds[:-1], bounds[1:]
+    keep = ends - starts > 1e-6
+    return starts[keep], ends[keep], proj
+
+
+def piece_rays(starts: np.ndarray, ends: np.ndarray, inset: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
+    """Two ray positions per piece, ``inset`` in from its ends (one at the middle for tiny pieces).
+
+    Returns ``positions (2p,)`` along the tangent and ``piece (2p,)`` indices.
+    """
+    length = ends - starts
+    a = np.where(length > 2 * inset, starts + inset, (starts + ends) / 2)
+    b = np.where(length > 2 * inset, ends - inset, (starts + ends) / 2)
+    return np.stack([a, b], 1).ravel(), np.repeat(np.arange(len(starts)), 2)
+
+
+def footprints(boxes: np.ndarray) -> np.ndarray:
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    return footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])

@@ -1,0 +1,63 @@
+"""Scores of extracted graphs against a source's ground-truth relations. Pure functions over DataFrames."""
+from __future__ import annotations
+
+import pandas as pd
+
+
+def support_scores(nodes: pd.DataFrame, gt: pd.DataFrame) -> dict:
+    """Support-parent accuracy over every object (GT parent or floor) and recall over supported objects."""
+    objs = nodes[nodes["kind"].astype(str) == "object"][["room_id", "node_id", "parent_id"]]
+    truth = gt[gt["relation"].astype(str) == "support"][["room_id", "anchor_id", "target_id"]]
+    truth = truth.rename(columns={"anchor_id": "true_parent", "target_id": "node_id"})
+    merged = objs.merge(truth, on=["room_id", "node_id"], how="left")
+    got = merged["parent_id"].astype(object).where(merged["parent_id"].notna(), None)
+    want = merged["true_parent"].astype(object).where(merged["true_parent"].notna(), None)
+    correct = (got == want) | (got.isna() & want.isna())
+    supported = want.notna()
+    return {"objects": int(len(merged)), "support_parent_accuracy": _ratio(correct.sum(), len(merged)),
+            "supported_objects": int(supported.sum()),
+            "support_parent_recall": _ratio((correct & supported).sum(), supported.sum())}
+
+
+def adjacency_scores(edges: pd.DataFrame, gt: pd.DataFrame) -> dict:
+    """Recall of intended adjacent relations as extracted adjacent spatial edges, and direction agreement."""
+    truth = gt[gt["relation"].astype(str) == "adjacent"][["room_id", "anchor_id", "target_id", "direction"]]
+    sp = edges[edges["edge_type"].astype(str) == "spatial"][["room_id", "source", "target", "direction", "distance"]]
+    merged = truth.merge(sp.rename(columns={"source": "anchor_id", "target": "target_id", "direction": "got_direction"}),
+                         on=["room_id", "anchor_id", "target_id"], how="left")
+    found = merged["distance"].astype(str) == "adjacent"
+    same_dir = found & (merged["got_direction"].astype(str) == merged["direction"].astype(str))
+    return {"intended_adjacent": int(len(merged)), "adjacent_recall": _ratio(found.sum(), len(merged)),
+            "adjacent_direction_agreement": _ratio(same_dir.sum(), found.sum()),
+            "intended_pairs_with_any_edge": _ratio(merged["distance"].notna().sum(), len(merged))}
+
+
+def _ratio(a, b) -> float | None:
+    return round(float(a) / float(b), 4) if b else None
+
+
+def _groups(frame: pd.DataFrame, anchor: str, member: str) -> set[tuple]:
+    """(room, anchor, frozenset of members) per group."""
+    out = set()
+    for (room, _), g in frame.groupby(["room_id", "group_id"]):
+        out.add((room, g[anchor].iloc[0], frozenset(g[member])))
+    return out
+
+
+def superstructure_scores(supers: pd.DataFrame, gt: pd.DataFrame) -> dict:
+    """Hub and chain precision / recall against the generator's groups (exact hub + spoke set, exact chain member set)."""
+    out = {}
+    for kind in ("hub", "chain"):
+        truth = gt[gt["relation"].astype(str) == kind]
+        found = supers[supers["kind"].astype(str) == kind]
+        t = _groups(truth, "anchor_id", "target_id") if len(truth) else set()
+        f = _groups(found, "anchor_id", "member_id") if len(found) else set()
+        if kind == "chain":  # a chain is the same whichever end it is read from
+            t = {(r, m) for r, _, m in t}
+            f = {(r, m) for r, _, m in f}
+        hit = len(t & f)
+        out[f"{kind}s_true"] = len(t)
+        out[f"{kind}s_found"] = len(f)
+        out[f"{kind}_precision"] = _ratio(hit, len(f)) if t else None  # a source without such ground truth scores nothing
+        out[f"{kind}_recall"] = _ratio(hit, len(t))
+    return out

@@ -1,0 +1,65 @@
+"""Extraction stage, one job per shard: a shard's kept rooms -> raw relation-graph tables (nodes, edges)."""
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from .. import tables
+from ..config import config_hash
+from ..extraction import extract_room
+from ..geometry.raycast import intersector_class
+from ..log import progress
+from ..roomdata import room_inputs
+
+log = logging.getLogger("planit.extract")
+
+
+def load_shard(rooms: Path, architecture: Path, objects: Path, models: Path):
+    """A shard's rooms and only their architecture, objects and models: the room and model filters are pushed
+    down into the Parquet reads, so rejected rooms and unused meshes are never loaded."""
+    room_df = tables.read(rooms, "rooms").to_pandas()
+    ids = room_df["room_id"].tolist()
+    arch = tables.read(architecture, "architecture", filters=[("room_id", "in", ids)]).to_pandas()
+    objs = tables.read(objects, "objects", filters=[("room_id", "in", ids)]).to_pandas()
+    used = sorted(set(objs["model_id"].dropna()))
+    rows = tables.read(models, "models", filters=[("model_id", "in", used)], columns=["model_id", "vertices", "faces"])
+    return room_df, arch, objs, {m["model_id"]: tables.model_mesh(m) for m in rows.to_pylist()}
+
+
+def run(config: dict, shard: int, rooms: Path, architecture: Path, objects: Path, models: Path, symmetry: Path,
+        out_nodes: Path, out_edges: Path, out_summary: Path) -> dict:
+    cfg = config["extract"]
+    intersector = intersector_class(cfg["backend"])
+    room_df, arch, objs, meshes = load_shard(rooms, architecture, objects, models)
+    sym = tables.read(symmetry, "symmetry", columns=["model_id", "symmetry", "origin"]).to_pylist()
+    by_model = {r["model_id"]: (r["symmetry"], r["origin"]) for r in sym}
+    nodes, edges, skipped = [], [], []
+    rays = cycles = 0
+    start = time.perf_counter()
+    for room in progress(room_inputs(room_df, arch, objs), total=len(room_df), desc=f"extract shard {shard}"):
+        try:
+            g = extract_room(room, meshes.get, lambda c, m: by_model.get(m, ("none", "default")), cfg, intersector)
+        except ValueError as exc:
+            log.warning("room %s skipped: %s", room.room_id, exc)
+            skipped.append({"room_id": room.room_id, "node_id": None, "reason": str(exc)})
+            continue
+        for node_id, reason in g.skipped:
+            log.warning("room %s: %s skipped: %s", room.room_id, node_id, reason)
+            skipped.append({"room_id": room.room_id, "node_id": node_id, "reason": reason})
+        rays += g.rays
+        cycles += g.support_cycles
+        for row in g.nodes + g.edges:
+            row.update(room_type=room.room_type, shard=shard)
+        nodes += g.nodes
+        edges += g.edges
+    seconds = time.perf_counter() - start
+    extra = {"config_hash": config_hash(cfg), "shard": str(shard)}
+    tables.write(out_nodes, "nodes", tables.from_rows("nodes", nodes), extra)
+    tables.write(out_edges, "edges", tables.from_rows("edges", edges), extra)
+    summary = {"shard": shard, "rooms": len(room_df), "nodes": len(nodes), "edges": len(edges), "rays": rays,
+               "support_cycles": cycles, "seconds": round(seconds, 3), "skipped": skipped, "backend": cfg["backend"]}
+    tables.write_json(out_summary, summary)
+    return {k: v for k, v in summary.items() if k != "skipped"} | {"skipped": len(skipped)}

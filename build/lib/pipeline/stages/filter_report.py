@@ -1,0 +1,22 @@
+"""Filter report (gather): every shard's report in one table, and rooms per (room type, outcome)."""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import pandas as pd
+
+from .. import tables
+from ..filtering import rule_counts
+
+log = logging.getLogger("planit.filter")
+
+
+def run(reports: list[Path], out_report: Path, out_counts: Path) -> pd.DataFrame:
+    table = tables.read_many(reports, "filter_report")
+    tables.write(out_report, "filter_report", table)
+    counts = rule_counts(table.to_pandas())
+    tables.write_tsv(out_counts, counts)
+    for row in counts.itertuples(index=False):
+        log.info("  %-9s %-18s %6d", row.room_type, row.outcome, row.rooms)
+    return counts

@@ -1,0 +1,28 @@
+"""Filter stage, one job per shard: every room gets a report row (kept, or the rule that rejected it)."""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import pyarrow as pa
+
+from .. import tables
+from ..config import config_hash
+from ..filtering import filter_rooms
+
+log = logging.getLogger("planit.filter")
+
+
+def run(config: dict, rooms: Path, architecture: Path, objects: Path, counts: Path, out_rooms: Path,
+        out_report: Path) -> dict:
+    """Write the shard's kept rooms (``rooms`` schema) and its filter report."""
+    room_df = tables.read(rooms, "rooms").to_pandas()
+    report = filter_rooms(room_df, tables.read(architecture, "architecture").to_pandas(),
+                          tables.read(objects, "objects").to_pandas(), config["filter"],
+                          tables.read(counts, "category_counts").to_pandas())
+    kept = room_df[room_df["room_id"].isin(report.loc[report["status"] == "kept", "room_id"])]
+    extra = {"config_hash": config_hash(config["filter"])}
+    tables.write(out_report, "filter_report", pa.Table.from_pandas(report, preserve_index=False), extra)
+    tables.write(out_rooms, "rooms", pa.Table.from_pandas(kept, preserve_index=False), extra)
+    log.info("kept %d of %d rooms", len(kept), len(room_df))
+    return {"rooms": len(room_df), "kept": len(kept)}

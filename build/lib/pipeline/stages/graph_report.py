@@ -1,0 +1,12 @@
+"""Graph report (per corpus): Table-1 statistics, pruning by rule and frequent relations as CSV, and one PNG."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..graphs.report import graph_report, write_report
+
+
+def run(nodes: Path, edges: Path, superstructures: Path, outputs: dict[str, Path]) -> dict:
+    report = graph_report(nodes, edges, superstructures)
+    write_report(report, outputs)
+    return {name: len(df) for name, df in report.items()}

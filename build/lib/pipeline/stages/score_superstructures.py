@@ -1,0 +1,20 @@
+"""Score the refined graphs' hubs and chains against the corpus's ground truth."""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from .. import tables
+from ..scoring import superstructure_scores
+
+log = logging.getLogger("planit.score")
+
+
+def run(nodes: Path, superstructures: Path, ground_truth: list[Path], out: Path) -> dict:
+    rooms = set(tables.read(nodes, "final_nodes", columns=["room_id"]).column("room_id").to_pylist())
+    gt = tables.read_many(ground_truth, "ground_truth").to_pandas()
+    metrics = {"rooms": len(rooms), **superstructure_scores(
+        tables.read(superstructures, "superstructures").to_pandas(), gt[gt["room_id"].isin(rooms)])}
+    tables.write_json(out, metrics)
+    log.info("scores: %s", metrics)
+    return metrics

@@ -1,0 +1,367 @@
+"""Canonical Parquet tables: every schema defined once, written atomically with metadata.
+
+Conventions for every table (docs/data-model.md): metres, radians, right-handed world frame with Z up;
+an object's local frame has +Y as its front, +X as its right, and ``yaw`` rotates local to world
+counter-clockwise about +Z.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Iterable
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from . import __version__
+from .errors import PlanitError
+
+COORDINATES = "metres; right-handed, Z up; object front = local +Y, right = local +X; yaw CCW about +Z (rad)"
+
+_STR = pa.string()
+_CAT = pa.dictionary(pa.int32(), pa.string())
+_F64 = pa.float64()
+_I32 = pa.int32()
+
+
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
+
+class TableError(PlanitError):
+    """A table file is unreadable or lacks a field; the message names the file and field."""
+
+
+def _f(name: str, type_: pa.DataType, unit: str | None = None, doc: str = "", nullable: bool = True) -> pa.Field:
+    meta = {"doc": doc}
+    if unit:
+        meta["unit"] = unit
+    return pa.field(name, type_, nullable=nullable, metadata=meta)
+
+
+def _box_fields() -> list[pa.Field]:
+    return [
+        _f("cx", _F64, "m", "oriented box centre, world x"),
+        _f("cy", _F64, "m", "oriented box centre, world y"),
+        _f("cz", _F64, "m", "oriented box centre, world z"),
+        _f("hx", _F64, "m", "half extent along local x (right)"),
+        _f("hy", _F64, "m", "half extent along local y (front)"),
+        _f("hz", _F64, "m", "half extent along z"),
+        _f("yaw", _F64, "rad", "rotation local->world about +Z, counter-clockwise"),
+    ]
+
+
+SCHEMAS: dict[str, pa.Schema] = {
+    "rooms": pa.schema([
+        _f("room_id", _STR, doc="unique room id", nullable=False),
+        _f("source", _CAT, doc="procedural | front3d | ithor | suncg"),
+        _f("room_type", _CAT, doc="canonical room type"),
+        _f("source_room_type", _STR, doc="room label as the source gave it"),
+        _f("floor_x", pa.list_(_F64), "m", "floor outline x, counter-clockwise, not repeated at the end"),
+        _f("floor_y", pa.list_(_F64), "m", "floor outline y"),
+        _f("height", _F64, "m", "floor to ceiling"),
+        _f("floor_area", _F64, "m^2", "area of the floor outline"),
+        _f("extent_x", _F64, "m", "axis-aligned floor extent along x"),
+        _f("extent_y", _F64, "m", "axis-aligned floor extent along y"),
+        _f("n_objects", _I32, doc="objects in the room at ingest"),
+        _f("shard", _I32, doc="shard index, assigned by the filter stage (null before)"),
+    ]),
+    "architecture": pa.schema([
+        _f("room_id", _STR, nullable=False),
+        _f("element_id", _STR, doc="unique within the room: wall_<i>, door_<i>, window_<i>", nullable=False),
+        _f("kind", _CAT, doc="wall | door | window"),
+        _f("x0", _F64, "m", "segment start (walls: on the inner face, loop counter-clockwise)"),
+        _f("y0", _F64, "m"),
+        _f("x1", _F64, "m", "segment end"),
+        _f("y1", _F64, "m"),
+        _f("z0", _F64, "m", "bottom"),
+        _f("z1", _F64, "m", "top"),
+        _f("thickness", _F64, "m", "walls: thickness behind the inner face"),
+        _f("wall_id", _STR, doc="doors and windows: the wall they sit in"),
+    ]),
+    "objects": pa.schema([
+        _f("room_id", _STR, nullable=False),
+        _f("object_id", _STR, doc="unique within the room", nullable=False),
+        _f("category", _CAT),
+        _f("model_id", _STR),
+        *_box_fields(),
+        _f("px", _F64, "m", "model origin, world x: world = Rz(yaw) (s * v) + p"),
+        _f("py", _F64, "m"),
+        _f("pz", _F64, "m"),
+        _f("sx", _F64, doc="model scale along local x (negative = mirrored)"),
+        _f("sy", _F64, doc="model scale along local y"),
+        _f("sz", _F64, doc="model scale along z"),
+        _f("source_parent_id", _STR, doc="support parent when the source records one"),
+    ]),
+    "models": pa.schema([
+        _f("model_id", _STR, nullable=False),
+        _f("category", _CAT),
+        _f("source", _CAT),
+        _f("vertices", pa.list_(pa.float32()), "m", "model-space vertices, flattened (n*3), front = +Y, Z up"),
+        _f("faces", pa.list_(_I32), doc="triangles, flattened (m*3) vertex indices"),
+        _f("mesh_kind", _CAT, doc="mesh | box_fallback"),
+        _f("mesh_path", _STR, doc="where the mesh came from, if a file"),
+        _f("min_x", _F64, "m"), _f("min_y", _F64, "m"), _f("min_z", _F64, "m"),
+        _f("max_x", _F64, "m"), _f("max_y", _F64, "m"), _f("max_z", _F64, "m"),
+    ]),
+    "ground_truth": pa.schema([
+        _f("room_id", _STR, nullable=False),
+        _f("relation", _CAT, doc="support | adjacent | hub | chain | faces | defect"),
+        _f("anchor_id", _STR, doc="parent / anchor / hub / chain start (object or element id)"),
+        _f("target_id", _STR, doc="child / target / spoke / chain member"),
+        _f("direction", _CAT, doc="front | back | left | right in the anchor's frame, when intended"),
+        _f("group_id", _STR, doc="hub or chain group"),
+        _f("label", _STR, doc="defect: the filter rule meant to reject the room; chain: adjacent | proximal"),
+    ]),
+    "filter_report": pa.schema([
+        _f("room_id", _STR, nullable=False),
+        _f("room_type", _CAT),
+        _f("status", _CAT, doc="kept | rejected"),
+        _f("rule", _CAT, doc="first rule that rejected the room (rule order in docs)"),
+        _f("rules", pa.list_(_STR), doc="every rule the room fails"),
+        _f("detail", _STR, doc="human-readable reason"),
+        _f("shard", _I32),
+    ]),
+    "ingest_report": pa.schema([
+        _f("source", _CAT),
+        _f("item", _STR, doc="house / room / object / model the row is about"),
+        _f("kind", _CAT, doc="house | room | wall | object | model | category"),
+        _f("status", _CAT, doc="read | skipped | kept | dropped | fallback | found | backed | open"),
+        _f("reason", _STR),
+        _f("count", pa.int64()),
+    ]),
+    "symmetry": pa.schema([
+        _f("model_id", _STR, nullable=False),
+        _f("category", _CAT),
+        _f("detected", _CAT, doc="symmetry type detected from the mesh (null when detection is off)"),
+        _f("table", _CAT, doc="symmetry type from the config table for the category (null: no entry)"),
+        _f("symmetry", _CAT, doc="the type used: the table's where it has an entry, else the detected one"),
+        _f("origin", _CAT, doc="table | detected | default"),
+    ]),
+    "nodes": pa.schema([
+        _f("room_id", _STR, nullable=False),
+        _f("node_id", _STR, nullable=False, doc="object_id or architecture element_id"),
+        _f("kind", _CAT, doc="object | wall | door | window"),
+        _f("category", _CAT, doc="object category; 'wall', 'door', 'window' for architecture"),
+        _f("model_id", _STR),
+        _f("symmetry", _CAT, doc="functional symmetry type"),
+        _f("symmetry_origin", _CAT, doc="table | detected | architecture"),
+        _f("tier", _I32, doc="0 architecture, 1 on the floor, 2 supported by a tier-1 object, ..."),
+        _f("parent_id", _STR, doc="support parent (null: floor)"),
+        *_box_fields(),
+        _f("length", _F64, "m", "walls, doors, windows: segment length"),
+        _f("room_type", _CAT),
+        _f("shard", _I32),
+    ]),
+    "edges": pa.schema([
+        _f("room_id", _STR, nullable=False),
+        _f("source", _STR, nullable=False, doc="anchor node"),
+        _f("target", _STR, nullable=False, doc="target node"),
+        _f("edge_type", _CAT, doc="support | spatial | wall_adjacent | wall_opposite | opening"),
+        _f("direction", _CAT, doc="front | back | left | right in the anchor's frame (null: support)"),
+        _f("distance", _CAT, doc="adjacent | proximal | distant (null: support)"),
+        _f("gap", _F64, "m", "smallest gap along the anchor's rays (negative: overlap)"),
+        _f("target_visibility", _F64, doc="visible share of the target's projected interval"),
+        _f("anchor_visibility", _F64, doc="share of the anchor side that sees the target"),
+        _f("score_front", _F64, doc="visibility from the front side (max of the two shares)"),
+        _f("score_back", _F64),
+        _f("score_left", _F64),
+        _f("score_right", _F64),
+        _f("angle", _F64, "rad", "wall -> wall: interior angle at the shared corner"),
+        _f("support_area", _F64, "m^2", "support: area of the grid cells resting on the parent"),
+        _f("room_type", _CAT),
+        _f("shard", _I32),
+    ]),
+}
+
+# refinement adds columns to the raw graph tables
+SCHEMAS["final_nodes"] = pa.schema([*SCHEMAS["nodes"], _f("role", _CAT, doc="hub | spoke | chain_start | chain_member | chain_end | none (chain roles may combine with hub roles: 'hub+chain_start')"),
+                                    _f("group_id", _STR, doc="the hub or chain the node belongs to")])
+SCHEMAS["final_edges"] = pa.schema([*SCHEMAS["edges"],
+                                    _f("status", _CAT, doc="kept | pruned"),
+                                    _f("rule", _CAT, doc="the rule that kept or pruned the edge (docs/data-model.md lists them)"),
+                                    _f("origin", _CAT, doc="raw (extracted) | derived (added by hub/chain inheritance or connectivity)"),
+                                    _f("group_id", _STR, doc="hub or chain whose edge this is")])
+SCHEMAS["superstructures"] = pa.schema([
+    _f("room_id", _STR, nullable=False), _f("room_type", _CAT),
+    _f("group_id", _STR, doc="hub_<k> | chain_<k>, unique within the room"),
+    _f("kind", _CAT, doc="hub | chain"),
+    _f("anchor_id", _STR, doc="the hub, or the chain's start"),
+    _f("member_id", _STR, doc="a spoke, or a chain member (the start included)"),
+    _f("position", _I32, doc="chain: index along the chain"),
+    _f("direction", _CAT, doc="hub: spoke direction from the hub; chain: direction of its edges"),
+    _f("label", _CAT, doc="chain: adjacent | proximal"),
+])
+SCHEMAS["cooccurrence"] = pa.schema([
+    _f("room_type", _CAT), _f("cat_a", _STR), _f("cat_b", _STR),
+    _f("rooms", pa.int64(), doc="rooms holding both (a room counts once; a == b needs two instances)"),
+])
+SCHEMAS["relations"] = pa.schema([
+    _f("room_type", _CAT), _f("cat_a", _STR, doc="anchor category"), _f("cat_b", _STR, doc="target category"),
+    _f("direction", _CAT), _f("distance", _CAT),
+    _f("rooms", pa.int64(), doc="rooms with at least one such raw edge"),
+    _f("cooccur_rooms", pa.int64(), doc="rooms where both categories occur"),
+    _f("freq", _F64, doc="rooms / cooccur_rooms: the share the pruning thresholds apply to"),
+])
+SCHEMAS["hub_patterns"] = pa.schema([
+    _f("room_type", _CAT), _f("hub_category", _STR), _f("spoke_category", _STR),
+    _f("count", pa.int64(), doc="candidate hub arrangements seen in the raw graphs"),
+    _f("accepted", pa.bool_(), doc="count >= refine.hub_min_pattern_count"),
+])
+SCHEMAS["category_counts"] = pa.schema([
+    _f("room_type", _CAT), _f("category", _STR),
+    _f("rooms", pa.int64(), doc="ingested rooms of the type holding the category (a room counts once)"),
+])
+SCHEMAS["partial_counts"] = pa.schema([
+    _f("kind", _CAT, doc="cooccurrence | relation | hub_pattern: one shard's share of a dataset-wide count"),
+    _f("room_type", _CAT), _f("cat_a", _STR, doc="anchor (hub) category"), _f("cat_b", _STR, doc="target (spoke) category"),
+    _f("direction", _CAT), _f("distance", _CAT),
+    _f("count", pa.int64(), doc="rooms (cooccurrence, relation) or candidate hubs (hub_pattern) in the shard"),
+])
+SCHEMAS["category_sizes"] = pa.schema([
+    _f("room_type", _CAT), _f("category", _STR), _f("instances", pa.int64()),
+    _f("mean_area", _F64, "m^2", "mean projected (footprint) box area"),
+    _f("mean_diag", _F64, "m", "mean footprint diagonal"),
+])
+
+
+def empty(name: str) -> pa.Table:
+    return SCHEMAS[name].empty_table()
+
+
+def from_rows(name: str, rows: Iterable[dict]) -> pa.Table:
+    """Build a table of the named schema from dict rows (missing columns are null)."""
+    schema = SCHEMAS[name]
+    rows = list(rows)
+    cols = {f.name: [r.get(f.name) for r in rows] for f in schema}
+    return pa.table({f.name: pa.array(cols[f.name], type=_plain(f.type)) for f in schema}).cast(schema)
+
+
+def _plain(t: pa.DataType) -> pa.DataType:
+    return t.value_type if pa.types.is_dictionary(t) else t
+
+
+def conform(name: str, table: pa.Table) -> pa.Table:
+    """Cast ``table`` to the named schema (columns in schema order, dictionary types applied)."""
+    schema = SCHEMAS[name]
+    missing = [f.name for f in schema if f.name not in table.column_names]
+    if missing:
+        raise TableError(f"table '{name}' lacks fields {missing}")
+    return table.select(schema.names).cast(schema)
+
+
+def write(path: str | Path, name: str, table: pa.Table, extra: dict | None = None) -> Path:
+    """Write ``table`` as schema ``name`` to ``path`` atomically (temp file in the same folder, then rename)."""
+    path = Path(path)
+    table = conform(name, table)
+    meta = {
+        "pipeline.schema": f"{name}/v1",
+        "pipeline.version": __version__,
+        "pipeline.coordinates": COORDINATES,
+    }
+    for key, value in (extra or {}).items():
+        meta[f"pipeline.{key}"] = value if isinstance(value, str) else json.dumps(value)
+    table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
+    return _atomic(path, lambda tmp: pq.write_table(table, tmp, compression="zstd"))
+
+
+def _atomic(path: Path, write_to) -> Path:
+    """Call ``write_to(temporary path)`` in ``path``'s folder, then rename onto ``path``; nothing is left on failure."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write_to(tmp)
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; shared (cluster) filesystems need the usual mode
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def write_json(path: str | Path, value) -> Path:
+    """A JSON side file (summaries, metrics), written atomically."""
+    text = json.dumps(value, indent=2)
+    return _atomic(Path(path), lambda tmp: Path(tmp).write_text(text))
+
+
+def write_tsv(path: str | Path, frame) -> Path:
+    """A tab-separated side file from a DataFrame, written atomically."""
+    return _atomic(Path(path), lambda tmp: frame.to_csv(tmp, sep="\t", index=False))
+
+
+def write_csv(path: str | Path, frame) -> Path:
+    """A comma-separated side file from a DataFrame, written atomically."""
+    return _atomic(Path(path), lambda tmp: frame.to_csv(tmp, index=False))
+
+
+def write_figure(path: str | Path, figure, **savefig) -> Path:
+    """A matplotlib figure, written atomically (the format follows ``path``'s suffix)."""
+    fmt = Path(path).suffix.lstrip(".") or "png"
+    return _atomic(Path(path), lambda tmp: figure.savefig(tmp, format=fmt, **savefig))
+
+
+def read(path: str | Path, name: str | None = None, filters=None, columns: list[str] | None = None) -> pa.Table:
+    """Read a pipeline table; with ``name``, check every field of that schema is present. ``filters`` (pyarrow
+    DNF, e.g. ``[("room_id", "in", ids)]``) are pushed down to the row groups; ``columns`` reads only those."""
+    if name is not None:
+        check(path, name)
+    try:
+        wanted = columns if columns is not None else (SCHEMAS[name].names if name is not None else None)
+        return pq.read_table(path, filters=filters, columns=wanted)
+    except FileNotFoundError as exc:
+        raise TableError(f"{path}: no such table file") from exc
+    except (pa.ArrowInvalid, OSError) as exc:
+        raise TableError(f"{path}: not a readable Parquet file: {exc}") from exc
+
+
+def check(path: str | Path, name: str) -> None:
+    """Fail with a TableError naming the file unless it is a readable table holding every field of ``name``
+    (reads the footer only)."""
+    path = Path(path)
+    if not path.exists():
+        raise TableError(f"{path}: no such table file")
+    try:
+        present = set(pq.read_schema(path).names)
+    except (pa.ArrowInvalid, OSError) as exc:
+        raise TableError(f"{path}: not a readable Parquet file: {exc}") from exc
+    missing = [f.name for f in SCHEMAS[name] if f.name not in present]
+    if missing:
+        raise TableError(f"{path}: table '{name}' lacks field(s) {', '.join(missing)}")
+
+
+def read_many(paths, name: str, columns: list[str] | None = None, filters=None) -> pa.Table:
+    """Concatenate tables of one schema (shards of a stage's output), in the given order."""
+    parts = [read(p, name, filters=filters, columns=columns) for p in paths]
+    if not parts:
+        table = empty(name)
+        return table.select(columns) if columns else table
+    return pa.concat_tables(parts).combine_chunks()
+
+
+def records_by_room(path: str | Path, name: str) -> dict[str, list[dict]]:
+    """A table's rows as plain dicts (strings, floats, None for nulls), grouped by ``room_id`` in file order."""
+    df = read(path, name).to_pandas()
+    for col in df.columns:
+        if hasattr(df[col], "cat"):
+            df[col] = df[col].astype(object)
+    df = df.astype(object).where(df.notna(), None)
+    return {k: g.to_dict("records") for k, g in df.groupby("room_id", sort=False)}
+
+
+def model_mesh(row: dict):
+    """(vertices (n, 3) float, faces (m, 3) int) of a ``models`` table row."""
+    import numpy as np
+
+    v = np.asarray(row["vertices"] if row["vertices"] is not None else [], dtype=float).reshape(-1, 3)
+    f = np.asarray(row["faces"] if row["faces"] is not None else [], dtype=np.int64).reshape(-1, 3)
+    return v, f
+
+
+def metadata(path: str | Path) -> dict[str, str]:
+    """The pipeline.* schema-level metadata of a table file."""
+    raw = pq.read_schema(path).metadata or {}
+    return {k.decode(): v.decode() for k, v in raw.items() if k.startswith(b"pipeline.")}
