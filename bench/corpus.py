@@ -4,26 +4,18 @@
 """
 from __future__ import annotations
 
-import time
-
 import pandas as pd
 
-from pipeline.stages import filter as filter_stage, ingest
-
-from common import arguments, default_config, report
+from common import arguments, default_config, ingest_and_filter, report, shard_paths
 
 
 def main() -> None:
     ap = arguments(__doc__)
     args = ap.parse_args()
     cfg = default_config()
-    t = time.perf_counter()
-    counts = ingest.run(cfg, args.workdir / "ingest")
-    t_ingest = time.perf_counter() - t
-    t = time.perf_counter()
-    filter_report = filter_stage.run(cfg, args.workdir / "ingest", args.workdir / "filter")
-    t_filter = time.perf_counter() - t
-    gt = pd.read_parquet(args.workdir / "ingest" / "ground_truth.parquet")
+    p = shard_paths(args.workdir)
+    counts, filter_report, t_ingest, t_filter = ingest_and_filter(cfg, p)
+    gt = pd.read_parquet(p["ground_truth"])
     planted = gt[gt["relation"] == "defect"].set_index("room_id")["label"]
     rep = filter_report.set_index("room_id")
     caught = sum(rule in rep.loc[room, "rules"] for room, rule in planted.items())

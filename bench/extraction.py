@@ -15,24 +15,25 @@ from pathlib import Path
 from pipeline.extraction import extract_room
 from pipeline.geometry.raycast import intersector_class
 from pipeline.roomdata import room_inputs
-from pipeline.stages import filter as filter_stage, ingest, symmetry
-from pipeline.stages.extract import load_shard
+from pipeline.stages import symmetry
+from pipeline.stages.extract_graphs import load_shard
 
-from common import arguments, default_config, report
+from common import arguments, default_config, ingest_and_filter, report, shard_paths
 
 
-def corpus(workdir: Path, cfg: dict) -> None:
-    if not (workdir / "filter" / "rooms.parquet").exists():
-        ingest.run(cfg, workdir / "ingest")
-        filter_stage.run(cfg, workdir / "ingest", workdir / "filter")
-    if not (workdir / "symmetry" / "symmetry.parquet").exists():
-        symmetry.run(cfg, workdir / "ingest", workdir / "symmetry")
+def corpus(workdir: Path, cfg: dict) -> dict[str, Path]:
+    p = shard_paths(workdir)
+    if not p["kept"].exists():
+        ingest_and_filter(cfg, p)
+    if not p["symmetry"].exists():
+        symmetry.run(cfg, [p["models"]], p["symmetry"], p["agreement"])
+    return p
 
 
 def run(workdir: Path, rooms_wanted: int, python_rooms: int) -> dict:
     cfg = default_config()
-    corpus(workdir, cfg)
-    rooms, arch, objs, models = load_shard(workdir / "ingest", workdir / "filter", 0)
+    p = corpus(workdir, cfg)
+    rooms, arch, objs, models = load_shard(p["kept"], p["architecture"], p["objects"], p["models"])
     inputs = list(room_inputs(rooms, arch, objs))[:rooms_wanted]
     sym = lambda c, m: ("none", "default")  # noqa: E731  symmetry does not change the ray work
     ex = cfg["extract"]

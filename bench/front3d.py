@@ -28,12 +28,12 @@ def main() -> None:
         ap.error("--repeat must be at least 2: one cold run, then warm ones")
     cache = args.workdir / "cache"
     shutil.rmtree(cache, ignore_errors=True)
-    cfg = config_mod.validate({"source": "front3d", "front3d": {"houses": str(args.sample / "houses"),
+    cfg = config_mod.validate({"source": "front3d", "shards": 1, "front3d": {"houses": str(args.sample / "houses"),
                                                                 "future": str(args.sample / "3d-future"), "cache_dir": str(cache)}})
     times = []
     for _ in range(args.repeat):
         t = time.perf_counter()
-        counts = ingest.run(cfg, args.workdir / "ingest")
+        counts = ingest.run(cfg, 0, {n: args.workdir / "ingest" / f"{n}.parquet" for n in ingest.OUTPUTS})
         times.append(time.perf_counter() - t)
     warm = statistics.median(times[1:])
     rep = pd.read_parquet(args.workdir / "ingest" / "ingest_report.parquet")

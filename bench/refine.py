@@ -7,24 +7,32 @@ from __future__ import annotations
 
 import time
 
-from pipeline.stages import extract, graphs
+from pipeline.stages import extract_graphs, graph_statistics, refine_graphs, shard_statistics
 
-from common import arguments, default_config, report
+from common import arguments, default_config, report, shard_paths
 
 
 def main() -> None:
     ap = arguments(__doc__)
     args = ap.parse_args()
     w = args.workdir
+    p = shard_paths(w)
     cfg = default_config()
+    raw = {n: w / "raw1" / f"{n}-0.parquet" for n in ("nodes", "edges")}
     t = time.perf_counter()
-    ex = extract.run(cfg, 0, w / "ingest", w / "filter", w / "raw1", w / "symmetry" / "symmetry.parquet")
+    ex = extract_graphs.run(cfg, 0, p["kept"], p["architecture"], p["objects"], p["models"], p["symmetry"],
+                            raw["nodes"], raw["edges"], w / "raw1" / "summary-0.json")
     t_extract = time.perf_counter() - t
+    stats = {n: w / "stats1" / f"{n}.parquet" for n in graph_statistics.STAT_TABLES}
     t = time.perf_counter()
-    graphs.run_statistics(cfg, w / "raw1", w / "stats1")
+    shard_statistics.run(cfg, raw["nodes"], raw["edges"], w / "stats1" / "partial-0.parquet",
+                         w / "stats1" / "candidates-0.parquet")
+    graph_statistics.run(cfg, [w / "stats1" / "partial-0.parquet"], [raw["nodes"]], stats)
     t_stats = time.perf_counter() - t
+    outs = {n: w / "final1" / f"{n}-0.parquet" for n in ("nodes", "edges", "superstructures")}
+    outs["summary"] = w / "final1" / "summary-0.json"
     t = time.perf_counter()
-    summary = graphs.run_refine(cfg, 0, w / "raw1", w / "stats1", w / "final1")
+    summary = refine_graphs.run(cfg, 0, raw["nodes"], raw["edges"], w / "stats1" / "candidates-0.parquet", stats, outs)
     t_refine = time.perf_counter() - t
     result = {"rooms": summary["rooms"], "extract_stage_seconds": round(t_extract, 2),
               "extract_stage_rooms_per_s": round(ex["rooms"] / t_extract, 1),

@@ -124,42 +124,12 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) 
     scene = RoomScene(parts + [plan], list(range(n)) + [0], [MESH] * n + [PLAN], intersector)
     scene.owner[-len(plan[1]):] = np.repeat(np.arange(n + n_walls), per_prism)  # one owner per prism
 
-    # rays: support grid under every object, then the visibility sweep of every anchor side
-    sc = cfg["support"]
-    raised = np.flatnonzero(b[:, 2] - b[:, 5] > FLOOR_EPS)  # nothing lies under the floor: only raised objects cast
-    s_orig, s_dir, s_obj, cell = relations.support_rays(b[raised], sc["grid"], sc["start_offset"])
-    s_obj = raised[s_obj]
-    cell = np.zeros(n) if not len(raised) else np.bincount(raised, weights=cell, minlength=n)
-    sym = [symmetry_of(c, m) for c, m in zip(cats, models)]
-    volume = np.prod(2 * b[:, 3:6], axis=1)
-    # support first (the sweep's groups depend on tiers): nearest mesh of another object below each grid point
-    reach = sc["start_offset"] + sc["max_distance"]
-    first_owner, first_dist = scene.first_accepted(
-        s_orig, s_dir, lambda r, own, lay: (lay == MESH) & (own != s_obj[r]), max_dist=reach)
-    if sc["inside_box_contact"]:
-        # grid points whose ray finds nothing within reach but that lie in another object's box rest in or on
-        # the smallest such box (box-only sources, whose boxes reach above their support surface: cushions on
-        # beds, things in fridges); a face level with the object's own bottom hides behind the bottom itself,
-        # so the point just below the bottom is tested too
-        miss = first_dist > reach
-        owner_in, _ = relations.containing_box(s_orig[miss], b, s_obj[miss], volume)
-        below = s_orig[miss] - [0.0, 0.0, sc["start_offset"] + 1e-3]
-        owner_in = np.where(owner_in >= 0, owner_in, relations.containing_box(below, b, s_obj[miss], volume)[0])
-        first_owner[miss] = np.where(owner_in >= 0, owner_in, first_owner[miss])
-        first_dist[miss] = np.where(owner_in >= 0, 0.0, first_dist[miss])
-    footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
-    parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
-    if sc["inside_box_contact"] and len(raised):  # raised, nothing below: held from around (hung in a slab)?
-        loose = raised[parent[raised] < 0]
-        held = relations.holding_box(b, loose)
-        parent[loose] = np.where(held >= 0, held, parent[loose])
-        area[loose] = np.where(held >= 0, footprint[loose], area[loose])
-    parent, cycles = relations.break_support_cycles(parent, footprint)
-    area[parent < 0] = 0.0
-    g.support_cycles = len(cycles)
+    # support first (the sweep's groups depend on tiers), then the visibility sweep of every anchor side
+    parent, area, rays, cycles = support_parents(scene, b, cfg["support"])
+    g.rays += rays
+    g.support_cycles = cycles
     tier = relations.tiers(parent)
-    g.rays += len(s_orig)
-
+    sym = [symmetry_of(c, m) for c, m in zip(cats, models)]
     for k in range(n):
         g.nodes.append({"room_id": room.room_id, "node_id": ids[k], "kind": "object", "category": cats[k],
                         "model_id": models[k], "symmetry": sym[k][0], "symmetry_origin": sym[k][1], "tier": int(tier[k]),
@@ -173,6 +143,49 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) 
     g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
     _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
     return g
+
+
+def support_parents(scene: RoomScene, b: np.ndarray, sc: dict) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """Support parent of every object (-1: the floor) and its supporting area.
+
+    ``b`` (n, 7) boxes, ``sc`` the ``extract.support`` config. Raised objects cast a grid of rays down; each ray
+    takes the nearest mesh of another object within reach; the parent is the object under the largest area.
+    Returns ``parent (n,)``, ``area (n,)`` m^2, the number of rays and of support cycles broken.
+    """
+    n = len(b)
+    raised = np.flatnonzero(b[:, 2] - b[:, 5] > FLOOR_EPS)  # nothing lies under the floor: only raised objects cast
+    s_orig, s_dir, s_obj, cell = relations.support_rays(b[raised], sc["grid"], sc["start_offset"])
+    s_obj = raised[s_obj]
+    cell = np.zeros(n) if not len(raised) else np.bincount(raised, weights=cell, minlength=n)
+    reach = sc["start_offset"] + sc["max_distance"]
+    first_owner, first_dist = scene.first_accepted(
+        s_orig, s_dir, lambda r, own, lay: (lay == MESH) & (own != s_obj[r]), max_dist=reach)
+    footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
+    if sc["inside_box_contact"]:
+        _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, sc["start_offset"])
+    parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
+    if sc["inside_box_contact"] and len(raised):  # raised, nothing below: held from around (hung in a slab)?
+        loose = raised[parent[raised] < 0]
+        held = relations.holding_box(b, loose)
+        parent[loose] = np.where(held >= 0, held, parent[loose])
+        area[loose] = np.where(held >= 0, footprint[loose], area[loose])
+    parent, cycles = relations.break_support_cycles(parent, footprint)
+    area[parent < 0] = 0.0
+    return parent, area, len(s_orig), len(cycles)
+
+
+def _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, start_offset) -> None:
+    """Box-only sources: a grid point whose ray finds nothing within reach but that lies in another object's box
+    rests in or on the smallest such box (boxes reach above their support surface: cushions on beds, things in
+    fridges); a face level with the object's own bottom hides behind the bottom itself, so the point just below
+    the bottom is tested too. Updates ``first_owner`` / ``first_dist`` in place."""
+    volume = np.prod(2 * b[:, 3:6], axis=1)
+    miss = first_dist > reach
+    owner_in, _ = relations.containing_box(s_orig[miss], b, s_obj[miss], volume)
+    below = s_orig[miss] - [0.0, 0.0, start_offset + 1e-3]
+    owner_in = np.where(owner_in >= 0, owner_in, relations.containing_box(below, b, s_obj[miss], volume)[0])
+    first_owner[miss] = np.where(owner_in >= 0, owner_in, first_owner[miss])
+    first_dist[miss] = np.where(owner_in >= 0, 0.0, first_dist[miss])
 
 
 def _usable_objects(g: RoomGraph, room: RoomInput, mesh_of) -> tuple[list[int], list]:
@@ -272,31 +285,16 @@ def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarra
 def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg) -> int:
     """Sweep every anchor side and add the visible spatial edges. Returns the number of rays cast."""
     n, n_walls = len(b), len(walls.ids)
-    total = n + n_walls
     sp = cfg["spatial"]
     sides = anchor_sides(b, walls, sp)
     piece_side, starts, ends = sweep(sides, all_fp, group)
-    pos, ray_piece = relations.piece_rays(starts, ends, PIECE_INSET)
-    ray_side = piece_side[ray_piece]
-    xy = sides["centre"][ray_side] + pos[:, None] * sides["tangent"][ray_side] - sides["normal"][ray_side] * sides["inset"][ray_side, None]
-    origins = np.column_stack([xy, np.full(len(pos), sum(PLAN_Z) / 2)])
-    dirs = np.column_stack([sides["normal"][ray_side], np.zeros(len(pos))])
-    anchor = sides["owner"][ray_side]
-    # supported anchors only see siblings on the same parent: their rays stop beyond the parent's footprint
     diag = np.concatenate([diagonal_2d(b[:, 3], b[:, 4]), np.zeros(n_walls)])  # walls: the target's diagonal decides
-    reach_of_group = np.concatenate([[np.inf], 2 * diag[:n]])  # group g > 0 lives on object g - 1
-    reach = sides["inset"][ray_side] + reach_of_group[group[anchor]]
-    hit_owner, hit_dist = scene.first_accepted(
-        origins, dirs, lambda r, own, lay: (lay == PLAN) & (own != anchor[r]) & (group[own] == group[anchor[r]]),
-        max_dist=reach)
-    pr = hit_dist.reshape(-1, 2)  # per piece: the nearer of its two rays
-    pick = np.argmin(pr, axis=1)
-    p_owner = hit_owner.reshape(-1, 2)[np.arange(len(pr)), pick]
-    p_dist = pr[np.arange(len(pr)), pick]
+    p_owner, p_dist, rays = _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n)
     ok = (p_owner >= 0) & (p_owner < n)  # pieces that reach an object (walls only occlude)
     contained = _contained_pairs(all_fp[:n], group[:n], sp["contain_fraction"])
     if not ok.any() and not contained:
-        return len(origins)
+        return rays
+    total = n + n_walls
     key = piece_side[ok] * total + p_owner[ok]
     uniq, inv = np.unique(key, return_inverse=True)
     vis = np.bincount(inv, weights=(ends - starts)[ok], minlength=len(uniq))
@@ -307,35 +305,59 @@ def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
     proj = np.einsum("mkj,mj->mk", all_fp[u_target], sides["tangent"][u_side])
     target_share = np.minimum(vis / np.maximum(np.ptp(proj, axis=1), 1e-9), 1.0)
     anchor_share = np.minimum(vis / (2 * sides["half"][u_side]), 1.0)
-    score = np.maximum(target_share, anchor_share)
     u_anchor, u_sidx = sides["owner"][u_side], sides["side"][u_side]
+    seen = {"anchor": u_anchor, "target": u_target, "side": u_sidx, "gap": gap, "target_share": target_share,
+            "anchor_share": anchor_share, "score": np.maximum(target_share, anchor_share)}
+    names = ids + walls.ids
+    _emit_spatial_edges(g, room_id, seen, contained, names, n, diag, radial, cfg)
+    return rays
+
+
+def _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n) -> tuple[np.ndarray, np.ndarray, int]:
+    """Two rays per sweep piece in the plan layer; per piece the nearer hit's owner and distance."""
+    pos, ray_piece = relations.piece_rays(starts, ends, PIECE_INSET)
+    ray_side = piece_side[ray_piece]
+    xy = sides["centre"][ray_side] + pos[:, None] * sides["tangent"][ray_side] - sides["normal"][ray_side] * sides["inset"][ray_side, None]
+    origins = np.column_stack([xy, np.full(len(pos), sum(PLAN_Z) / 2)])
+    dirs = np.column_stack([sides["normal"][ray_side], np.zeros(len(pos))])
+    anchor = sides["owner"][ray_side]
+    # supported anchors only see siblings on the same parent: their rays stop beyond the parent's footprint
+    reach_of_group = np.concatenate([[np.inf], 2 * diag[:n]])  # group g > 0 lives on object g - 1
+    reach = sides["inset"][ray_side] + reach_of_group[group[anchor]]
+    hit_owner, hit_dist = scene.first_accepted(
+        origins, dirs, lambda r, own, lay: (lay == PLAN) & (own != anchor[r]) & (group[own] == group[anchor[r]]),
+        max_dist=reach)
+    pr = hit_dist.reshape(-1, 2)  # per piece: the nearer of its two rays
+    pick = np.argmin(pr, axis=1)
+    return hit_owner.reshape(-1, 2)[np.arange(len(pr)), pick], pr[np.arange(len(pr)), pick], len(origins)
+
+
+def _emit_spatial_edges(g, room_id, seen: dict, contained, names, n, diag, radial, cfg) -> None:
+    """One edge per (anchor, target) from the best qualifying side: highest visibility, then smallest gap."""
+    total = len(names)
+    a_, t_ = seen["anchor"], seen["target"]
     side_scores = np.zeros((total, total, 4))
-    side_scores[u_anchor, u_target, u_sidx] = score
-    # best qualifying side per (anchor, target): highest visibility, then smallest gap
-    cand = np.flatnonzero(score >= sp["min_visibility"])
-    cand = cand[np.lexsort((gap[cand], -score[cand], u_target[cand], u_anchor[cand]))]
-    pairs = u_anchor[cand] * total + u_target[cand]
-    unique_pairs, first = np.unique(pairs, return_index=True)
+    side_scores[a_, t_, seen["side"]] = seen["score"]
+    cand = np.flatnonzero(seen["score"] >= cfg["spatial"]["min_visibility"])
+    cand = cand[np.lexsort((seen["gap"][cand], -seen["score"][cand], t_[cand], a_[cand]))]
+    unique_pairs, first = np.unique(a_[cand] * total + t_[cand], return_index=True)
     best = dict(zip(unique_pairs.tolist(), cand[first].tolist()))
     for a, t in contained:
         best.setdefault(a * total + t, -1)
-    u_label = relations.distance_labels(gap, np.maximum(diag[u_anchor], diag[u_target]), cfg["distance"])
+    labels = relations.distance_labels(seen["gap"], np.maximum(diag[a_], diag[t_]), cfg["distance"])
     for pair in sorted(best):
         a, t = divmod(pair, total)
         i = best[pair]
-        is_wall = a >= n
         if i < 0:  # target mostly inside the anchor's footprint, seen by no ray
             direction, gap_i, tv, av, label = "front", 0.0, 1.0, 1.0, "adjacent"
         else:
-            direction = "front" if is_wall or radial[a] else SIDES[u_sidx[i]]
-            gap_i, tv, av = float(gap[i]), float(target_share[i]), float(anchor_share[i])
-            label = "adjacent" if (a, t) in contained else str(u_label[i])
+            direction = "front" if a >= n or radial[a] else SIDES[seen["side"][i]]
+            gap_i, tv, av = float(seen["gap"][i]), float(seen["target_share"][i]), float(seen["anchor_share"][i])
+            label = "adjacent" if (a, t) in contained else str(labels[i])
         sc = side_scores[a, t]
-        src = walls.ids[a - n] if is_wall else ids[a]
-        g.edges.append(_edge(room_id, src, ids[t], "spatial", direction, label, gap=gap_i, target_visibility=tv,
+        g.edges.append(_edge(room_id, names[a], names[t], "spatial", direction, label, gap=gap_i, target_visibility=tv,
                              anchor_visibility=av, score_front=float(sc[0]), score_back=float(sc[1]),
                              score_left=float(sc[2]), score_right=float(sc[3])))
-    return len(origins)
 
 
 def _contained_pairs(fp: np.ndarray, group: np.ndarray, fraction: float) -> set[tuple[int, int]]:

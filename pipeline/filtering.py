@@ -11,6 +11,7 @@ import shapely
 
 from .geometry import boxes
 from .geometry.polygon import wall_loop
+from .roomdata import room_slices
 
 RULES = ("unknown_room_type", "wall_loop", "room_height", "room_size", "too_few_objects", "too_many_objects",
          "mislabeled", "rare_category", "outside_room", "interpenetration")
@@ -24,13 +25,14 @@ def category_room_counts(rooms: pd.DataFrame, objects: pd.DataFrame) -> pd.DataF
             .sort_values(["room_type", "category"], ignore_index=True))
 
 
-def _room_reasons(room, walls: pd.DataFrame, objs: pd.DataFrame, cfg: dict, rare: set) -> list[tuple[str, str]]:
+def _room_reasons(room, segs: np.ndarray, objs: dict, cfg: dict, rare: set) -> list[tuple[str, str]]:
+    """Every rule ``room`` (a rooms row) fails, with its detail. ``segs`` (w, 2, 2) are its walls; ``objs`` holds its
+    objects' arrays (``ids``, ``categories``, ``boxes`` (n, 7), ``parents``)."""
     out: list[tuple[str, str]] = []
     rtype = room.room_type
     if rtype not in cfg["min_floor_objects"]:
         out.append(("unknown_room_type", f"room type '{rtype}' has no filter settings"))
         return out
-    segs = walls[["x0", "y0", "x1", "y1"]].to_numpy(float).reshape(-1, 2, 2)
     closed, why, _ = wall_loop(segs, cfg["wall_closure_tolerance"])
     if not closed:
         out.append(("wall_loop", why))
@@ -40,36 +42,40 @@ def _room_reasons(room, walls: pd.DataFrame, objs: pd.DataFrame, cfg: dict, rare
     if big > cfg["max_extent"] or small < cfg["min_extent"]:
         out.append(("room_size", f"extents {room.extent_x:.2f} x {room.extent_y:.2f} m outside "
                                  f"[{cfg['min_extent']}, {cfg['max_extent']}] m"))
-    bottom = objs["cz"].to_numpy() - objs["hz"].to_numpy()
-    floor = int((bottom <= cfg["floor_tolerance"]).sum())
+    b, ids = objs["boxes"], objs["ids"]
+    floor = int((b[:, 2] - b[:, 5] <= cfg["floor_tolerance"]).sum())
     if floor < cfg["min_floor_objects"][rtype]:
         out.append(("too_few_objects", f"{floor} floor objects < {cfg['min_floor_objects'][rtype]}"))
-    if len(objs) > cfg["max_objects"][rtype]:
-        out.append(("too_many_objects", f"{len(objs)} objects > {cfg['max_objects'][rtype]}"))
+    if len(b) > cfg["max_objects"][rtype]:
+        out.append(("too_many_objects", f"{len(b)} objects > {cfg['max_objects'][rtype]}"))
     required = cfg["required_categories"].get(rtype) or []
-    cats = set(objs["category"].astype(str))
+    cats = set(objs["categories"])
     if required and not cats & set(required):
         out.append(("mislabeled", f"a {rtype} without any of {sorted(required)}"))
     rare_here = sorted(c for c in cats if (rtype, c) in rare)
     if rare_here:
         out.append(("rare_category", f"rare in {rtype}: {', '.join(rare_here)}"))
-    if len(objs):
-        b = objs[["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]].to_numpy(float)
-        corners = boxes.footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
-        outline = shapely.Polygon(np.column_stack([room.floor_x, room.floor_y]))
-        pts = shapely.points(corners.reshape(-1, 2))
-        poke = np.where(shapely.covers(outline, pts), 0.0, shapely.distance(outline.exterior, pts)).reshape(-1, 4).max(1)
-        worst = int(np.argmax(poke))
-        if poke[worst] > cfg["outside_tolerance"]:
-            out.append(("outside_room", f"{objs.iloc[worst]['object_id']} pokes {poke[worst]:.2f} m out of the room"))
-        depth = boxes.penetration_depths(b)
-        ids = objs["object_id"].astype(str).to_numpy()
-        parents = objs["source_parent_id"].astype(object).to_numpy()
-        related = (parents[:, None] == ids[None, :]) | (parents[None, :] == ids[:, None])
-        depth[related] = 0.0
-        i, j = np.unravel_index(int(np.argmax(depth)), depth.shape)
-        if depth[i, j] > cfg["max_penetration"]:
-            out.append(("interpenetration", f"{ids[i]} and {ids[j]} interpenetrate by {depth[i, j]:.2f} m"))
+    if len(b):
+        out += _placement_reasons(room, b, ids, objs["parents"], cfg)
+    return out
+
+
+def _placement_reasons(room, b: np.ndarray, ids: np.ndarray, parents: np.ndarray, cfg: dict) -> list[tuple[str, str]]:
+    """outside_room and interpenetration for a room's boxes ``b`` (n, 7)."""
+    out = []
+    corners = boxes.footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
+    outline = shapely.Polygon(np.column_stack([room.floor_x, room.floor_y]))
+    pts = shapely.points(corners.reshape(-1, 2))
+    poke = np.where(shapely.covers(outline, pts), 0.0, shapely.distance(outline.exterior, pts)).reshape(-1, 4).max(1)
+    worst = int(np.argmax(poke))
+    if poke[worst] > cfg["outside_tolerance"]:
+        out.append(("outside_room", f"{ids[worst]} pokes {poke[worst]:.2f} m out of the room"))
+    depth = boxes.penetration_depths(b)
+    related = (parents[:, None] == ids[None, :]) | (parents[None, :] == ids[:, None])
+    depth[related] = 0.0
+    i, j = np.unravel_index(int(np.argmax(depth)), depth.shape)
+    if depth[i, j] > cfg["max_penetration"]:
+        out.append(("interpenetration", f"{ids[i]} and {ids[j]} interpenetrate by {depth[i, j]:.2f} m"))
     return out
 
 
@@ -82,13 +88,18 @@ def filter_rooms(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.Da
     """
     rare = set(map(tuple, counts.loc[counts["rooms"] < cfg["min_category_rooms"], ["room_type", "category"]]
                    .astype(str).to_numpy()))
-    walls = architecture[architecture["kind"].astype(str) == "wall"]
-    walls_by_room = dict(tuple(walls.groupby("room_id", sort=False)))
-    objs_by_room = dict(tuple(objects.groupby("room_id", sort=False)))
-    empty_w, empty_o = walls.iloc[:0], objects.iloc[:0]
+    walls = architecture[architecture["kind"].astype(str) == "wall"].sort_values("room_id", kind="stable")
+    objs = objects.sort_values("room_id", kind="stable")
+    w_slices, o_slices = room_slices(walls), room_slices(objs)
+    segs = walls[["x0", "y0", "x1", "y1"]].to_numpy(float).reshape(-1, 2, 2)
+    arrays = {"ids": objs["object_id"].astype(str).to_numpy(), "categories": objs["category"].astype(str).to_numpy(),
+              "boxes": objs[["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]].to_numpy(float),
+              "parents": objs["source_parent_id"].astype(object).to_numpy()}
+    empty = slice(0, 0)
     rows = []
     for room in rooms.itertuples(index=False):
-        reasons = _room_reasons(room, walls_by_room.get(room.room_id, empty_w), objs_by_room.get(room.room_id, empty_o),
+        so = o_slices.get(room.room_id, empty)
+        reasons = _room_reasons(room, segs[w_slices.get(room.room_id, empty)], {k: v[so] for k, v in arrays.items()},
                                 cfg, rare)
         kept = not reasons
         rows.append({"room_id": room.room_id, "room_type": room.room_type, "status": "kept" if kept else "rejected",

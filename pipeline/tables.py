@@ -344,12 +344,12 @@ def read_many(paths, name: str, columns: list[str] | None = None, filters=None) 
 
 def records_by_room(path: str | Path, name: str) -> dict[str, list[dict]]:
     """A table's rows as plain dicts (strings, floats, None for nulls), grouped by ``room_id`` in file order."""
-    df = read(path, name).to_pandas()
-    for col in df.columns:
-        if hasattr(df[col], "cat"):
-            df[col] = df[col].astype(object)
-    df = df.astype(object).where(df.notna(), None)
-    return {k: g.to_dict("records") for k, g in df.groupby("room_id", sort=False)}
+    table = read(path, name)
+    table = table.cast(pa.schema([pa.field(f.name, _plain(f.type)) for f in table.schema]))
+    out: dict[str, list[dict]] = {}
+    for row in table.to_pylist():
+        out.setdefault(row["room_id"], []).append(row)
+    return out
 
 
 def model_mesh(row: dict):

@@ -57,6 +57,8 @@ rule score_extraction:
         ground_truth=repeat("--ground-truth", "ground_truth"),
     log:
         "logs/score_extraction/{corpus}.log",
+    benchmark:
+        "benchmarks/score_extraction/{corpus}.tsv"
     conda:
         ENV
     shell:

@@ -34,6 +34,8 @@ rule ingest_summary:
         reports=repeat("--report", "reports"),
     log:
         "logs/ingest_summary/ingest_summary.log",
+    benchmark:
+        "benchmarks/ingest_summary/ingest_summary.tsv"
     conda:
         ENV
     shell:
@@ -73,6 +75,8 @@ rule filter_report:
         reports=repeat("--report", "reports"),
     log:
         "logs/filter_report/filter_report.log",
+    benchmark:
+        "benchmarks/filter_report/filter_report.tsv"
     conda:
         ENV
     shell:

@@ -14,6 +14,8 @@ rule shard_statistics:
                     "refine.chain_collinearity"),
     log:
         "logs/shard_statistics/{corpus}-{shard}.log",
+    benchmark:
+        "benchmarks/shard_statistics/{corpus}-{shard}.tsv"
     conda:
         ENV
     shell:
@@ -86,6 +88,8 @@ rule gather_graphs:
         superstructures=repeat("--superstructures", "superstructures"),
     log:
         "logs/gather_graphs/{corpus}.log",
+    benchmark:
+        "benchmarks/gather_graphs/{corpus}.tsv"
     conda:
         ENV
     shell:
@@ -104,6 +108,8 @@ rule score_superstructures:
         ground_truth=repeat("--ground-truth", "ground_truth"),
     log:
         "logs/score_superstructures/{corpus}.log",
+    benchmark:
+        "benchmarks/score_superstructures/{corpus}.tsv"
     conda:
         ENV
     shell:
@@ -123,6 +129,8 @@ rule graph_report:
         plot=report(REPORT.replace("{name}", "graph_stats.png"), caption="../docs/report/graph_stats.rst", category="Graphs"),
     log:
         "logs/graph_report/{corpus}.log",
+    benchmark:
+        "benchmarks/graph_report/{corpus}.tsv"
     conda:
         ENV
     shell:

@@ -57,6 +57,49 @@ def _norm(name: str) -> str:
     return {"python-duckdb": "duckdb", "pytorch": "torch"}.get(name, name).lower().replace("_", "-")
 
 
+def _conda_pins(path) -> dict:
+    env = yaml.safe_load(path.read_text())
+    conda = {}
+    deps = []
+    for dep in env["dependencies"]:
+        deps += dep["pip"] if isinstance(dep, dict) else [dep]
+    for dep in deps:
+        m = re.match(r"([A-Za-z0-9_.-]+)\s*(=|>=)\s*(\S+)", dep.replace("==", "="))
+        if m and m.group(1) != "python":
+            conda[_norm(m.group(1))] = ("==" if m.group(2) == "=" else ">=", m.group(3))
+    return conda
+
+
+def test_gpu_environment_has_the_same_pins_as_the_cpu_one():
+    cpu, gpu = _conda_pins(ROOT / "environment.yml"), _conda_pins(ROOT / "environment-gpu.yml")
+    test_only = {"pytest", "hypothesis", "snakemake-executor-plugin-slurm"}
+    assert {k: v for k, v in cpu.items() if k not in test_only} == gpu
+    assert "pytorch-cuda" in (ROOT / "environment-gpu.yml").read_text()
+
+
+def test_schema_is_package_data_in_json_schema_2020_12():
+    schema = config.load_schema()
+    assert schema["$schema"] == "https://json-schema.org/draft/2020-12/schema" and "$defs" in schema
+    assert (ROOT / "config" / "schema.yaml").resolve() == (ROOT / "pipeline" / "schema.yaml").resolve()
+
+
+def test_config_errors_are_one_line(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("refine:\n  thresholds: {adjacent: 2, proximal: nope}\n")
+    with pytest.raises(config.ConfigError) as err:
+        config.load(bad)
+    assert "\n" not in str(err.value) and "refine.thresholds.adjacent" in str(err.value)
+
+
+def test_pick_holds_exactly_the_dotted_keys():
+    cfg = config.validate({})
+    picked = config.pick(cfg, ["seed", "extract.support", "refine.thresholds.proximal"])
+    assert picked == {"seed": 0, "extract": {"support": cfg["extract"]["support"]}, "refine": {"thresholds": {"proximal": 0.08}}}
+    assert config.restrict(cfg, picked) == picked
+    with pytest.raises(config.ConfigError, match="no config key 'extract.nope'"):
+        config.pick(cfg, ["extract.nope"])
+
+
 def test_environment_yml_matches_pyproject():
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
     pins = {}

@@ -91,6 +91,13 @@ def build_models(variants: int, seed: int) -> tuple[dict[str, list[Model]], list
     return by_cat, rows
 
 
+def _overlap(a: shapely.Polygon, b: shapely.Polygon) -> bool:
+    """Footprints overlapping by more than 1 mm^2 (bounds checked first: most pairs are far apart)."""
+    ax0, ay0, ax1, ay1 = a.bounds
+    bx0, by0, bx1, by1 = b.bounds
+    return ax0 < bx1 and bx0 < ax1 and ay0 < by1 and by0 < ay1 and a.intersection(b).area > 1e-6
+
+
 def _direction_label(anchor_category: str, local_xy: np.ndarray) -> str:
     """front/back/left/right of a point in an anchor's local frame (radial anchors: always front)."""
     cat = catalog.CATEGORIES.get(anchor_category)
@@ -117,6 +124,8 @@ class RoomBuilder:
     keepout: list = field(default_factory=list)
     index: int = 0
     _groups: int = 0
+    _placed: list = field(default_factory=list)  # footprints of the first-tier objects placed so far
+    _room: shapely.Polygon | None = None
 
     # ------------------------------------------------------------------ architecture
     def make_shell(self, l_shape: bool, size_range: tuple[float, float], height: float) -> None:
@@ -169,20 +178,24 @@ class RoomBuilder:
         options = self.models[category]
         return options[int(self.rng.integers(len(options)))] if variant is None else options[variant % len(options)]
 
-    def _footprint(self, m: Model, cx: float, cy: float, yaw: float) -> shapely.Polygon:
-        return shapely.Polygon(boxes.footprint_corners(cx, cy, m.w / 2, m.d / 2, yaw)[0])
+    @staticmethod
+    def _footprint(m: Model, cx: float, cy: float, yaw: float) -> shapely.Polygon:
+        """The footprint polygon (the arithmetic of ``boxes.footprint_corners``, for one box without NumPy)."""
+        c, s = math.cos(yaw), math.sin(yaw)
+        hx, hy = m.w / 2, m.d / 2
+        return shapely.Polygon([(c * lx - s * ly + cx, s * lx + c * ly + cy)
+                                for lx, ly in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))])
 
     def fits(self, placements: list[tuple[Model, float, float, float]]) -> bool:
         """All footprints inside the room, outside the door swing, clear of every first-tier object."""
-        room = shapely.Polygon(self.outline).buffer(1e-6)
-        placed = [self._footprint(o.model, o.cx, o.cy, o.yaw) for o in self.objects if o.parent is None]
+        if self._room is None:
+            self._room = shapely.Polygon(self.outline).buffer(1e-6)
+        placed = list(self._placed)
         for m, cx, cy, yaw in placements:
             fp = self._footprint(m, cx, cy, yaw)
-            if not room.covers(fp):
+            if not self._room.covers(fp):
                 return False
-            if any(fp.intersection(k).area > 1e-6 for k in self.keepout):
-                return False
-            if any(fp.intersection(p).area > 1e-6 for p in placed):
+            if any(_overlap(fp, k) for k in self.keepout) or any(_overlap(fp, p) for p in placed):
                 return False
             placed.append(fp)
         return True
@@ -192,6 +205,8 @@ class RoomBuilder:
         self.objects.append(o)
         if parent is not None:
             self.relation("support", parent, o.object_id)
+        else:
+            self._placed.append(self._footprint(m, cx, cy, yaw))
         return o
 
     def relation(self, relation: str, anchor: str | None, target: str | None, direction: str | None = None,

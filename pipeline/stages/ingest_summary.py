@@ -5,7 +5,6 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import pyarrow as pa
 
 from .. import duck, tables
 from ..errors import InputError

@@ -87,12 +87,12 @@ def ingest(shard: int = ShardOpt, config: Optional[Path] = ConfigOpt, config_jso
 
 @app.command("ingest-summary")
 def ingest_summary(rooms: List[Path] = _files("--rooms"), objects: List[Path] = _files("--objects"),
-                   report: List[Path] = _files("--report"), out_counts: Path = _file("--out-counts"),
+                   models: List[Path] = _files("--models"), report: List[Path] = _files("--report"), out_counts: Path = _file("--out-counts"),
                    out_report: Path = _file("--out-report")) -> None:
     """Gather the ingest shards: category counts for the filter, the summed ingest report."""
     from .stages import ingest_summary as stage
 
-    _summary(_guard(stage.run, rooms, objects, report, out_counts, out_report))
+    _summary(_guard(stage.run, rooms, objects, models, report, out_counts, out_report))
 
 
 @app.command("filter")

@@ -9,8 +9,8 @@ import pandas as pd
 from .extraction import BOX_COLUMNS, POSE_COLUMNS, RoomInput
 
 
-def _slices(frame: pd.DataFrame) -> dict[str, slice]:
-    """Row ranges of each room in a frame sorted by room_id."""
+def room_slices(frame: pd.DataFrame) -> dict[str, slice]:
+    """Row ranges of each room in a frame whose rows are grouped by room_id (e.g. sorted by it)."""
     ids = frame["room_id"].to_numpy()
     if not len(ids):
         return {}
@@ -24,7 +24,7 @@ def room_inputs(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.Dat
     """One RoomInput per row of ``rooms`` (in its order), gathering its walls, openings and objects."""
     arch = architecture.sort_values(["room_id", "element_id"], kind="stable").reset_index(drop=True)
     objs = objects.sort_values(["room_id"], kind="stable").reset_index(drop=True)
-    a_slices, o_slices = _slices(arch), _slices(objs)
+    a_slices, o_slices = room_slices(arch), room_slices(objs)
     kind = arch["kind"].astype(str).to_numpy()
     a_ids = arch["element_id"].astype(str).to_numpy()
     a_xy = arch[["x0", "y0", "x1", "y1"]].to_numpy(float)

@@ -5,7 +5,6 @@ import logging
 import time
 from pathlib import Path
 
-import pandas as pd
 
 from .. import tables
 from ..config import config_hash

@@ -53,7 +53,6 @@ def ingest_procedural(config: dict, shard: int, shards: int) -> dict[str, pa.Tab
     used = {o["model_id"] for o in objs}
     report = Counter({("room", "read", rt): n for rt, n in Counter(r["room_type"] for r in rooms).items()})
     report.update({("category", "found", c): n for c, n in Counter(o["category"] for o in objs).items()})
-    report[("model", "kept", "catalogue models used")] = len(used)
     return _tables(rooms, arch, objs, [m for m in model_rows if m["model_id"] in used], gt,
                    _report_rows("procedural", report), shard)
 
@@ -81,7 +80,8 @@ def ingest_front3d(config: dict, shard: int, shards: int) -> dict[str, pa.Table]
     out = {"rooms": [], "architecture": [], "objects": [], "models": {}}
     for f in progress(files, desc=f"3D-FRONT houses, shard {shard}"):
         _house(front3d.parse_house, (f, catalogue, cache, cfg, report), out, report)
-    report[("model", "kept", f"meshes parsed {cache.parsed}, from cache {cache.hits}")] += len(out["models"])
+    report[("model", "parsed", "OBJ meshes parsed")] += cache.parsed
+    report[("model", "cached", "OBJ meshes read from the cache")] += cache.hits
     return _tables(out["rooms"], out["architecture"], out["objects"], list(out["models"].values()), [],
                    _report_rows("front3d", report), shard)
 

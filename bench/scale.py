@@ -1,0 +1,53 @@
+"""The whole workflow on N procedural rooms, end to end on this machine: wall time, time per rule, peak memory per job.
+
+    .venv/bin/python bench/scale.py --rooms 20000 [--shards 8] [--cores 2] [--workdir bench/out/scale-20000]
+
+Rooms are split over the five room types in the default config's proportions. Per-job seconds and peak
+resident memory come from Snakemake's own benchmark files (``benchmarks/<rule>/*.tsv``).
+"""
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+from common import ROOT, arguments, report
+
+MIX = {"bedroom": 500, "living": 400, "office": 350, "bathroom": 400, "kitchen": 400}
+
+
+def main() -> None:
+    ap = arguments(__doc__)
+    ap.add_argument("--rooms", type=int, default=20000)
+    ap.add_argument("--shards", type=int, default=8)
+    ap.add_argument("--cores", type=int, default=2)
+    args = ap.parse_args()
+    work = args.workdir if args.workdir.name.startswith("scale") else args.workdir / f"scale-{args.rooms}"
+    work.mkdir(parents=True, exist_ok=True)
+    total = sum(MIX.values())
+    rooms = {t: round(n * args.rooms / total) for t, n in MIX.items()}
+    cfg = work / "config.yaml"
+    cfg.write_text((ROOT / "config" / "config.yaml").read_text() + f"\n# bench/scale.py\nshards: {args.shards}\n"
+                   f"procedural:\n  rooms: {rooms}\n")
+    t0 = time.perf_counter()
+    subprocess.run([str(Path(sys.executable).parent / "snakemake"), "--snakefile", str(ROOT / "Snakefile"), "-d", str(work),
+                    "--configfile", str(cfg), "--cores", str(args.cores), "-q"], check=True)
+    wall = time.perf_counter() - t0
+    seconds, rss = defaultdict(float), defaultdict(float)
+    for tsv in (work / "benchmarks").rglob("*.tsv"):
+        rule = tsv.parent.name
+        row = next(csv.DictReader(tsv.open(), delimiter="\t"))
+        seconds[rule] += float(row["s"])
+        rss[rule] = max(rss[rule], float(row["max_rss"]) if row["max_rss"] not in ("", "NA", "-") else 0.0)
+    result = {"rooms": sum(rooms.values()), "shards": args.shards, "cores": args.cores, "wall_seconds": round(wall, 1),
+              "job_seconds_per_rule": {k: round(v, 1) for k, v in sorted(seconds.items())},
+              "peak_rss_mb_per_rule": {k: round(v) for k, v in sorted(rss.items())},
+              "peak_rss_mb": round(max(rss.values(), default=0.0))}
+    report(result, args.workdir, f"scale-{args.rooms}")
+
+
+if __name__ == "__main__":
+    main()

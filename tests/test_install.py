@@ -1,0 +1,97 @@
+"""The package as a user meets it: the README's commands verbatim, and a wheel installed without the source tree."""
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from conftest import ROOT
+
+pytestmark = pytest.mark.slow
+BIN = Path(sys.executable).parent
+CLUSTER_ONLY = ("--workflow-profile profiles/slurm",)  # tests/slurm/run.sh runs that one on a real Slurm
+
+
+def readme_commands() -> list[str]:
+    """`make pipeline` and every `.venv/bin/...` line of the README's bash blocks, in order, comments stripped
+    (`make test` is this suite)."""
+    text = (ROOT / "README.md").read_text()
+    lines = [line for block in re.findall(r"```bash\n(.*?)```", text, re.S) for line in block.splitlines()]
+    return [line.split(" #")[0].strip() for line in lines if line.startswith((".venv/bin/", "make pipeline"))]
+
+
+def _env_without_venv() -> dict:
+    path = os.pathsep.join(p for p in os.environ["PATH"].split(os.pathsep) if Path(p) != BIN)
+    return {k: v for k, v in os.environ.items() if k != "VIRTUAL_ENV"} | {"PATH": path}
+
+
+@pytest.fixture(scope="module")
+def clone(tmp_path_factory) -> Path:
+    """The repository's tracked files in a fresh folder, its venv linked, config/config.yaml made tiny."""
+    dest = tmp_path_factory.mktemp("clone")
+    files = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    for rel in filter(None, files.split("\0")):
+        src = ROOT / rel
+        (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+        if src.is_symlink():
+            os.symlink(os.readlink(src), dest / rel)
+        elif src.exists():
+            shutil.copy2(src, dest / rel)
+    (dest / ".venv").symlink_to(BIN.parent)
+    shutil.copy(ROOT / "config" / "tiny.yaml", dest / "config" / "config.yaml")
+    return dest
+
+
+def test_readme_commands_work_as_written(clone):
+    commands = readme_commands()
+    assert len(commands) >= 8
+    ran = 0
+    for cmd in commands:
+        if any(c in cmd for c in CLUSTER_ONLY):
+            continue
+        out = subprocess.run(shlex.split(cmd), cwd=clone, capture_output=True, text=True, env=_env_without_venv(),
+                             timeout=600)
+        assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}"
+        ran += 1
+        if "-d /tmp/" in cmd:  # a run in a work folder of its own: it produced the graphs
+            work = Path(cmd.split("-d ")[1].split()[0])
+            assert (work / "results/graphs/ingested/edges.parquet").exists(), cmd
+            shutil.rmtree(work)
+    assert ran == len(commands) - 1
+
+
+def test_wheel_installs_and_runs_without_the_source_tree(tmp_path):
+    wheels = tmp_path / "wheels"
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(wheels),
+                    str(ROOT)], check=True, capture_output=True, timeout=300)
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True, timeout=120)
+    site = next(venv.glob("lib/python*/site-packages"))
+    wheel = next(wheels.glob("planit_pipeline-*.whl"))
+    subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(site), str(wheel)],
+                   check=True, capture_output=True, timeout=300)
+    # dependencies from the test venv, after the installed package (not the editable checkout: .pth files there are
+    # not processed when the folder is added this way)
+    deps = next(BIN.parent.glob("lib/python*/site-packages"))
+    (site / "zz_deps.pth").write_text(f"{deps}\n")
+    work = tmp_path / "run"
+    work.mkdir()
+    py = venv / "bin" / "python"
+    where = subprocess.run([str(py), "-c", "import pipeline; print(pipeline.__file__)"], cwd=work, capture_output=True,
+                           text=True, check=True).stdout.strip()
+    assert where.startswith(str(site)), where
+    outs = [a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report")
+            for a in (f"--{n}", str(work / f"{n}.parquet"))]
+    cfg = '{"shards": 1, "procedural": {"rooms": {"bedroom": 2, "living": 1, "office": 0, "bathroom": 1, "kitchen": 0}}}'
+    out = subprocess.run([str(py), "-m", "pipeline", "ingest", "--shard", "0", "--config-json", cfg, *outs], cwd=work,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert pq.read_table(work / "rooms.parquet").num_rows == 4
+    bad = subprocess.run([str(py), "-m", "pipeline", "ingest", "--shard", "0", "--config-json", '{"shards": 0}', *outs],
+                         cwd=work, capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "invalid config at key 'shards'" in bad.stderr  # the schema came with the wheel
