@@ -28,7 +28,8 @@ def main() -> None:
     work = args.workdir if args.workdir.name.startswith("scale") else args.workdir / f"scale-{args.rooms}"
     work.mkdir(parents=True, exist_ok=True)
     total = sum(MIX.values())
-    rooms = {t: round(n * args.rooms / total) for t, n in MIX.items()}
+    rooms = {t: n * args.rooms // total for t, n in MIX.items()}
+    rooms["bedroom"] += args.rooms - sum(rooms.values())  # exactly --rooms
     cfg = work / "config.yaml"
     cfg.write_text((ROOT / "config" / "config.yaml").read_text() + f"\n# bench/scale.py\nshards: {args.shards}\n"
                    f"procedural:\n  rooms: {rooms}\n")

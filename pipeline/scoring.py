@@ -1,11 +1,13 @@
 """Scores of extracted graphs against a source's ground-truth relations. Pure functions over DataFrames."""
 from __future__ import annotations
 
+from collections import Counter
+
 import pandas as pd
 
 
-def support_scores(nodes: pd.DataFrame, gt: pd.DataFrame) -> dict:
-    """Support-parent accuracy over every object (GT parent or floor) and recall over supported objects."""
+def extraction_counts(nodes: pd.DataFrame, edges: pd.DataFrame, gt: pd.DataFrame) -> Counter:
+    """The integer counts behind the extraction scores for one set of rooms (sums over shards stay exact)."""
     objs = nodes[nodes["kind"].astype(str) == "object"][["room_id", "node_id", "parent_id"]]
     truth = gt[gt["relation"].astype(str) == "support"][["room_id", "anchor_id", "target_id"]]
     truth = truth.rename(columns={"anchor_id": "true_parent", "target_id": "node_id"})
@@ -14,22 +16,26 @@ def support_scores(nodes: pd.DataFrame, gt: pd.DataFrame) -> dict:
     want = merged["true_parent"].astype(object).where(merged["true_parent"].notna(), None)
     correct = (got == want) | (got.isna() & want.isna())
     supported = want.notna()
-    return {"objects": int(len(merged)), "support_parent_accuracy": _ratio(correct.sum(), len(merged)),
-            "supported_objects": int(supported.sum()),
-            "support_parent_recall": _ratio((correct & supported).sum(), supported.sum())}
-
-
-def adjacency_scores(edges: pd.DataFrame, gt: pd.DataFrame) -> dict:
-    """Recall of intended adjacent relations as extracted adjacent spatial edges, and direction agreement."""
-    truth = gt[gt["relation"].astype(str) == "adjacent"][["room_id", "anchor_id", "target_id", "direction"]]
+    adjacent = gt[gt["relation"].astype(str) == "adjacent"][["room_id", "anchor_id", "target_id", "direction"]]
     sp = edges[edges["edge_type"].astype(str) == "spatial"][["room_id", "source", "target", "direction", "distance"]]
-    merged = truth.merge(sp.rename(columns={"source": "anchor_id", "target": "target_id", "direction": "got_direction"}),
-                         on=["room_id", "anchor_id", "target_id"], how="left")
-    found = merged["distance"].astype(str) == "adjacent"
-    same_dir = found & (merged["got_direction"].astype(str) == merged["direction"].astype(str))
-    return {"intended_adjacent": int(len(merged)), "adjacent_recall": _ratio(found.sum(), len(merged)),
-            "adjacent_direction_agreement": _ratio(same_dir.sum(), found.sum()),
-            "intended_pairs_with_any_edge": _ratio(merged["distance"].notna().sum(), len(merged))}
+    pairs = adjacent.merge(sp.rename(columns={"source": "anchor_id", "target": "target_id", "direction": "got_direction"}),
+                           on=["room_id", "anchor_id", "target_id"], how="left")
+    found = pairs["distance"].astype(str) == "adjacent"
+    same_dir = found & (pairs["got_direction"].astype(str) == pairs["direction"].astype(str))
+    return Counter({"rooms": int(nodes["room_id"].nunique()), "objects": len(merged), "correct": int(correct.sum()),
+                    "supported": int(supported.sum()), "correct_supported": int((correct & supported).sum()),
+                    "intended": len(pairs), "found": int(found.sum()), "same_dir": int(same_dir.sum()),
+                    "any_edge": int(pairs["distance"].notna().sum())})
+
+
+def extraction_scores(c: Counter) -> dict:
+    """Support-parent accuracy (every object: GT parent or floor) and recall (supported objects); recall of intended
+    adjacent relations as extracted adjacent spatial edges, and direction agreement."""
+    return {"rooms": c["rooms"], "objects": c["objects"], "support_parent_accuracy": _ratio(c["correct"], c["objects"]),
+            "supported_objects": c["supported"], "support_parent_recall": _ratio(c["correct_supported"], c["supported"]),
+            "intended_adjacent": c["intended"], "adjacent_recall": _ratio(c["found"], c["intended"]),
+            "adjacent_direction_agreement": _ratio(c["same_dir"], c["found"]),
+            "intended_pairs_with_any_edge": _ratio(c["any_edge"], c["intended"])}
 
 
 def _ratio(a, b) -> float | None:

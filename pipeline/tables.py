@@ -256,15 +256,33 @@ def write(path: str | Path, name: str, table: pa.Table, extra: dict | None = Non
     """Write ``table`` as schema ``name`` to ``path`` atomically (temp file in the same folder, then rename)."""
     path = Path(path)
     table = conform(name, table)
-    meta = {
-        "pipeline.schema": f"{name}/v1",
-        "pipeline.version": __version__,
-        "pipeline.coordinates": COORDINATES,
-    }
+    table = table.replace_schema_metadata({**(table.schema.metadata or {}), **_metadata(name, extra)})
+    return _atomic(path, lambda tmp: pq.write_table(table, tmp, compression="zstd"))
+
+
+def _metadata(name: str, extra: dict | None) -> dict[str, str]:
+    meta = {"pipeline.schema": f"{name}/v1", "pipeline.version": __version__, "pipeline.coordinates": COORDINATES}
     for key, value in (extra or {}).items():
         meta[f"pipeline.{key}"] = value if isinstance(value, str) else json.dumps(value)
-    table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
-    return _atomic(path, lambda tmp: pq.write_table(table, tmp, compression="zstd"))
+    return meta
+
+
+def write_parts(path: str | Path, name: str, parts, extra: dict | None = None) -> int:
+    """Write an iterable of tables of schema ``name`` as one file, part by part (row groups), atomically, without
+    holding more than one part in memory. Returns the number of rows."""
+    schema = SCHEMAS[name]
+    meta = {**(schema.metadata or {}), **_metadata(name, extra)}
+    rows = 0
+
+    def write_to(tmp):
+        nonlocal rows
+        with pq.ParquetWriter(tmp, schema.with_metadata(meta), compression="zstd") as writer:
+            for part in parts:
+                writer.write_table(conform(name, part).replace_schema_metadata(meta))
+                rows += part.num_rows
+
+    _atomic(Path(path), write_to)
+    return rows
 
 
 def _atomic(path: Path, write_to) -> Path:

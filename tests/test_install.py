@@ -30,10 +30,8 @@ def _env_without_venv() -> dict:
     return {k: v for k, v in os.environ.items() if k != "VIRTUAL_ENV"} | {"PATH": path}
 
 
-@pytest.fixture(scope="module")
-def clone(tmp_path_factory) -> Path:
-    """The repository's tracked files in a fresh folder, its venv linked, config/config.yaml made tiny."""
-    dest = tmp_path_factory.mktemp("clone")
+def copy_tracked(dest: Path) -> Path:
+    """The repository's tracked files (as in a fresh clone) copied to ``dest``."""
     files = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
     for rel in filter(None, files.split("\0")):
         src = ROOT / rel
@@ -42,6 +40,13 @@ def clone(tmp_path_factory) -> Path:
             os.symlink(os.readlink(src), dest / rel)
         elif src.exists():
             shutil.copy2(src, dest / rel)
+    return dest
+
+
+@pytest.fixture(scope="module")
+def clone(tmp_path_factory) -> Path:
+    """A fresh copy of the repository, its venv linked, config/config.yaml made tiny."""
+    dest = copy_tracked(tmp_path_factory.mktemp("clone"))
     (dest / ".venv").symlink_to(BIN.parent)
     shutil.copy(ROOT / "config" / "tiny.yaml", dest / "config" / "config.yaml")
     return dest
@@ -67,8 +72,9 @@ def test_readme_commands_work_as_written(clone):
 
 def test_wheel_installs_and_runs_without_the_source_tree(tmp_path):
     wheels = tmp_path / "wheels"
+    source = copy_tracked(tmp_path / "source")  # the build writes build/ beside the sources: not in the checkout
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(wheels),
-                    str(ROOT)], check=True, capture_output=True, timeout=300)
+                    str(source)], check=True, capture_output=True, timeout=300)
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True, timeout=120)
     site = next(venv.glob("lib/python*/site-packages"))

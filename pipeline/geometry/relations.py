@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
+from .boxes import footprint_corners, rotation
 
 DISTANCES = ("adjacent", "proximal", "distant")
 
@@ -141,40 +141,6 @@ def tiers(parent: np.ndarray) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------- visibility
-def box_sides(box) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray, float, float]]:
-    """The four vertical sides of a box: (name, centre (2,), tangent (2,), outward normal (2,), half length,
-    depth of the box along the normal)."""
-    cx, cy, _, hx, hy, _, yaw = box
-    r = rotation(yaw)
-    out = []
-    for name, n_local in zip(SIDES, SIDE_NORMALS):
-        n = r @ n_local
-        t = np.array([n[1], -n[0]])  # right-hand tangent when looking out of the side
-        half_depth, half_len = (hy, hx) if n_local[1] != 0 else (hx, hy)
-        out.append((name, np.array([cx, cy]) + n * half_depth, t, n, float(half_len), float(2 * half_depth)))
-    return out
-
-
-def sweep_pieces(centre: np.ndarray, tangent: np.ndarray, normal: np.ndarray, half_len: float,
-                 corners: np.ndarray, behind: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Split an anchor side at the projected endpoints of candidate footprints.
-
-    ``corners`` is ``(k, 4, 2)``; candidates wholly behind the ray origins (more than ``behind`` behind the
-    side) or outside the side's span are ignored. Returns ``starts (p,)``, ``ends (p,)`` along the tangent
-    (relative to ``centre``) and ``proj (k, 2)`` each candidate's projected interval.
-    """
-    rel = corners - centre
-    t = rel @ tangent
-    d = rel @ normal
-    proj = np.stack([t.min(axis=1), t.max(axis=1)], 1)
-    live = (d.max(axis=1) > -behind) & (proj[:, 1] > -half_len) & (proj[:, 0] < half_len)
-    cuts = np.clip(proj[live].ravel(), -half_len, half_len)
-    bounds = np.unique(np.concatenate([[-half_len, half_len], cuts]))
-    starts, ends = bounds[:-1], bounds[1:]
-    keep = ends - starts > 1e-6
-    return starts[keep], ends[keep], proj
-
-
 def piece_rays(starts: np.ndarray, ends: np.ndarray, inset: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
     """Two ray positions per piece, ``inset`` in from its ends (one at the middle for tiny pieces).
 

@@ -39,21 +39,33 @@ def surface_samples(vertices: np.ndarray, faces: np.ndarray, count: int, seed: i
     return np.asarray(pts) - centre
 
 
+class Invariances:
+    """Which transforms of :data:`TRANSFORMS` map the sampled surface (``points (n, 3)``) onto itself, tested only
+    when asked (``inv["rot90"]``) and then remembered: :func:`classify` stops at the first type that holds."""
+
+    def __init__(self, points: np.ndarray, tolerance: float) -> None:
+        self.points = points
+        self.limit = tolerance * float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+        self.tree = cKDTree(points)
+        self.known: dict[str, bool] = {}
+
+    def __getitem__(self, name: str) -> bool:
+        if name not in self.known:
+            moved = self.points @ TRANSFORMS[name].T
+            d1 = self.tree.query(moved)[0]
+            d2 = cKDTree(moved).query(self.points)[0]
+            self.known[name] = float(max(d1.mean(), d2.mean())) <= self.limit
+        return self.known[name]
+
+
 def invariances(points: np.ndarray, tolerance: float) -> dict[str, bool]:
-    """Which transforms of :data:`TRANSFORMS` map the sampled surface onto itself."""
-    diag = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
-    tree = cKDTree(points)
-    out = {}
-    for name, m in TRANSFORMS.items():
-        moved = points @ m.T
-        d1 = tree.query(moved)[0]
-        d2 = cKDTree(moved).query(points)[0]
-        out[name] = float(max(d1.mean(), d2.mean())) <= tolerance * diag
-    return out
+    """Every transform of :data:`TRANSFORMS` tested: whether it maps the sampled surface onto itself."""
+    inv = Invariances(points, tolerance)
+    return {name: inv[name] for name in TRANSFORMS}
 
 
-def classify(inv: dict[str, bool]) -> str:
-    """Symmetry type from invariances, most symmetric first."""
+def classify(inv) -> str:
+    """Symmetry type from invariances (a mapping transform name -> bool), most symmetric first."""
     if inv["rot_odd"] and inv["rot_45"]:
         return "radial"
     if inv["rot90"]:
@@ -75,4 +87,5 @@ def detect(vertices: np.ndarray, faces: np.ndarray, tolerance: float = 0.02, sam
     """Symmetry type of a model-space mesh (front = +Y)."""
     if len(faces) == 0:
         return "none"
-    return classify(invariances(surface_samples(np.asarray(vertices, float), np.asarray(faces), samples, seed), tolerance))
+    points = surface_samples(np.asarray(vertices, float), np.asarray(faces), samples, seed)
+    return classify(Invariances(points, tolerance))

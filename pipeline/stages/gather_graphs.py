@@ -11,16 +11,28 @@ from .. import tables
 SCHEMA_OF = {"nodes": "final_nodes", "edges": "final_edges", "superstructures": "superstructures"}
 
 
+def _room_types(paths: list[Path]) -> list[str]:
+    types: set[str] = set()
+    for p in paths:
+        types |= set(pc.unique(tables.read(p, None, columns=["room_type"]).column("room_type").cast(pa.string()))
+                     .drop_null().to_pylist())
+    return sorted(types)
+
+
+def _parts(paths: list[Path], schema: str):
+    """One part per (room type, shard), in room-type order: a row group never mixes room types, so readers
+    filtering on ``room_type`` skip the others, and only one shard's rows of one type are in memory at a time."""
+    for t in _room_types(paths):
+        for p in paths:
+            part = tables.read(p, schema, filters=[("room_type", "=", t)])
+            if part.num_rows:
+                yield part
+
+
 def run(inputs: dict[str, list[Path]], outputs: dict[str, Path]) -> dict:
-    """Concatenate each table's shards, sorted by room type then room (so ``filters=[('room_type', '=', t)]`` skips
-    row groups of other types; the order within a room is kept)."""
+    """Stream each table's shards into one file, room type by room type (each shard keeps its room order)."""
     counts = {}
     for name, schema in SCHEMA_OF.items():
-        table = tables.read_many(inputs[name], schema)
-        if table.num_rows:
-            keys = pa.table({"t": table["room_type"].cast(pa.string()), "r": table["room_id"],
-                             "i": pa.array(range(table.num_rows))})
-            table = table.take(pc.sort_indices(keys, sort_keys=[("t", "ascending"), ("r", "ascending"), ("i", "ascending")]))
-        tables.write(outputs[name], schema, table, {"shards": str(len(inputs[name]))})
-        counts[name] = table.num_rows
+        counts[name] = tables.write_parts(outputs[name], schema, _parts(inputs[name], schema),
+                                          {"shards": str(len(inputs[name]))})
     return counts

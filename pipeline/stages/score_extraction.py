@@ -2,20 +2,28 @@
 from __future__ import annotations
 
 import logging
+from collections import Counter
 from pathlib import Path
 
 from .. import tables
-from ..scoring import adjacency_scores, support_scores
+from ..scoring import extraction_counts, extraction_scores
 
 log = logging.getLogger("planit.score")
 
 
 def run(nodes: list[Path], edges: list[Path], ground_truth: list[Path], out: Path) -> dict:
-    node_df = tables.read_many(nodes, "nodes").to_pandas()
-    gt = tables.read_many(ground_truth, "ground_truth").to_pandas()
-    gt = gt[gt["room_id"].isin(set(node_df["room_id"]))]
-    metrics = {"rooms": int(node_df["room_id"].nunique()), **support_scores(node_df, gt),
-               **adjacency_scores(tables.read_many(edges, "edges").to_pandas(), gt)}
+    """Counts shard by shard (shard k's rooms, edges and ground truth), then the scores: memory does not grow
+    with the corpus."""
+    if not len(nodes) == len(edges) == len(ground_truth):
+        raise tables.TableError(f"score: {len(nodes)} node, {len(edges)} edge and {len(ground_truth)} ground-truth "
+                                "tables: one of each per shard")
+    counts = Counter()
+    for n, e, g in zip(nodes, edges, ground_truth):
+        node_df = tables.read(n, "nodes").to_pandas()
+        ids = node_df["room_id"].unique().tolist()
+        gt = tables.read(g, "ground_truth", filters=[("room_id", "in", ids)] if ids else None).to_pandas()
+        counts += extraction_counts(node_df, tables.read(e, "edges").to_pandas(), gt[gt["room_id"].isin(ids)])
+    metrics = extraction_scores(counts)
     tables.write_json(out, metrics)
     log.info("scores: %s", metrics)
     return metrics

@@ -12,7 +12,7 @@ log = logging.getLogger("planit.score")
 
 def run(nodes: Path, superstructures: Path, ground_truth: list[Path], out: Path) -> dict:
     rooms = set(tables.read(nodes, "final_nodes", columns=["room_id"]).column("room_id").to_pylist())
-    gt = tables.read_many(ground_truth, "ground_truth").to_pandas()
+    gt = tables.read_many(ground_truth, "ground_truth", filters=[("relation", "in", ["hub", "chain"])]).to_pandas()
     metrics = {"rooms": len(rooms), **superstructure_scores(
         tables.read(superstructures, "superstructures").to_pandas(), gt[gt["room_id"].isin(rooms)])}
     tables.write_json(out, metrics)

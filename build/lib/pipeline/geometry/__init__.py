@@ -1,1 +1,0 @@
-"""Pure geometry over NumPy arrays (no file IO): polygons, oriented boxes, meshes, rays, symmetry."""

@@ -1,1 +1,0 @@
-"""Graph refinement (paper §4.3, appendix A): superstructures, pruning, connectivity. Pure functions per room."""
