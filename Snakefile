@@ -1,5 +1,5 @@
 # PlanIT pipeline. Run: snakemake --cores 2   (profiles/default is picked up automatically)
-# --configfile FILE replaces config/config.yaml (keys it leaves out take the schema's defaults).
+# --configfile FILE extends config/config.yaml: its keys override, the rest come from config/config.yaml.
 from snakemake.utils import min_version
 
 min_version("9.0")

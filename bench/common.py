@@ -34,9 +34,10 @@ def report(result: dict, workdir: Path, name: str) -> None:
 
 def shard_paths(workdir: Path) -> dict[str, Path]:
     """Where the one-shard benchmark corpus lives under ``workdir``."""
-    names = ("rooms", "architecture", "objects", "models", "ground_truth", "ingest_report")
+    names = ("rooms", "architecture", "objects", "models", "ground_truth", "ingest_report", "drops")
     paths = {n: workdir / "ingest" / f"{n}-0.parquet" for n in names}
     paths.update(counts=workdir / "ingest" / "category_counts.parquet", summary=workdir / "ingest" / "report.parquet",
+                 all_drops=workdir / "ingest" / "drops.parquet",
                  kept=workdir / "filter" / "rooms-0.parquet", filter_report=workdir / "filter" / "report-0.parquet",
                  symmetry=workdir / "symmetry" / "symmetry.parquet", agreement=workdir / "symmetry" / "agreement.json")
     return paths
@@ -52,9 +53,9 @@ def ingest_and_filter(cfg: dict, p: dict[str, Path]) -> tuple[dict, object, floa
     from pipeline.stages import filter_rooms, ingest, ingest_summary
 
     t = time.perf_counter()
-    counts = ingest.run(cfg, 0, {n: p[n] for n in ("rooms", "architecture", "objects", "models", "ground_truth",
-                                                  "ingest_report")})
-    ingest_summary.run([p["rooms"]], [p["objects"]], [p["models"]], [p["ingest_report"]], p["counts"], p["summary"])
+    counts = ingest.run(cfg, 0, {n: p[n] for n in ingest.OUTPUTS})
+    ingest_summary.run([p["rooms"]], [p["objects"]], [p["models"]], [p["ingest_report"]], [p["drops"]], p["counts"],
+                       p["summary"], p["all_drops"])
     t_ingest = time.perf_counter() - t
     t = time.perf_counter()
     filter_rooms.run(cfg, p["rooms"], p["architecture"], p["objects"], p["counts"], p["kept"], p["filter_report"])

@@ -76,23 +76,25 @@ def main(verbose: bool = typer.Option(False, "--verbose", "-v")) -> None:
 def ingest(shard: int = ShardOpt, config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
            rooms: Path = _file("--rooms"), architecture: Path = _file("--architecture"), objects: Path = _file("--objects"),
            models: Path = _file("--models"), ground_truth: Path = _file("--ground-truth"),
-           report: Path = _file("--report", "the shard's ingest report")) -> None:
+           report: Path = _file("--report", "the shard's ingest report"),
+           drops: Path = _file("--drops", "one row per dropped house, room, object or model")) -> None:
     """Read one shard of the configured source into canonical tables."""
     from .stages import ingest as stage
 
     outs = {"rooms": rooms, "architecture": architecture, "objects": objects, "models": models,
-            "ground_truth": ground_truth, "ingest_report": report}
+            "ground_truth": ground_truth, "ingest_report": report, "drops": drops}
     _summary(_stage(stage.run, config, config_json, shard, outs))
 
 
 @app.command("ingest-summary")
 def ingest_summary(rooms: List[Path] = _files("--rooms"), objects: List[Path] = _files("--objects"),
-                   models: List[Path] = _files("--models"), report: List[Path] = _files("--report"), out_counts: Path = _file("--out-counts"),
-                   out_report: Path = _file("--out-report")) -> None:
-    """Gather the ingest shards: category counts for the filter, the summed ingest report."""
+                   models: List[Path] = _files("--models"), report: List[Path] = _files("--report"),
+                   drops: List[Path] = _files("--drops"), out_counts: Path = _file("--out-counts"),
+                   out_report: Path = _file("--out-report"), out_drops: Path = _file("--out-drops")) -> None:
+    """Gather the ingest shards: category counts for the filter, the summed ingest report, every drop."""
     from .stages import ingest_summary as stage
 
-    _summary(_guard(stage.run, rooms, objects, models, report, out_counts, out_report))
+    _summary(_guard(stage.run, rooms, objects, models, report, drops, out_counts, out_report, out_drops))
 
 
 @app.command("filter")

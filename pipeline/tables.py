@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Iterable
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from . import __version__
@@ -132,6 +133,17 @@ SCHEMAS: dict[str, pa.Schema] = {
         _f("reason", _STR),
         _f("count", pa.int64()),
     ]),
+    "drops": pa.schema([
+        _f("source", _CAT),
+        _f("file", _STR, doc="the source file"),
+        _f("house_id", _STR, doc="house uid, where the source has houses"),
+        _f("room_id", _STR, doc="the room (for rooms, objects: the id it would have had)"),
+        _f("item_id", _STR, doc="object: furniture uid / object id; model: model id; mesh: mesh uid"),
+        _f("level", _CAT, doc="house | room | object | model | mesh"),
+        _f("status", _CAT, doc="dropped | skipped | fallback (a model replaced by its box)"),
+        _f("field", _STR, doc="JSON path of the field at fault, e.g. scene.room[2].children[5].pos"),
+        _f("reason", _STR),
+    ]),
     "symmetry": pa.schema([
         _f("model_id", _STR, nullable=False),
         _f("category", _CAT),
@@ -227,6 +239,47 @@ SCHEMAS["category_sizes"] = pa.schema([
 ])
 
 
+# Rows are unique by these columns; the write refuses a duplicate.
+KEYS = {"rooms": ["room_id"], "architecture": ["room_id", "element_id"], "objects": ["room_id", "object_id"],
+        "models": ["model_id"], "symmetry": ["model_id"], "nodes": ["room_id", "node_id"],
+        "final_nodes": ["room_id", "node_id"], "filter_report": ["room_id"]}
+# The rule that writes each kind of table: a missing or corrupt one is reported with the rule to rerun.
+PRODUCERS = {"rooms": "ingest or filter_rooms", "architecture": "ingest", "objects": "ingest", "models": "ingest",
+             "ground_truth": "ingest", "ingest_report": "ingest or ingest_summary", "drops": "ingest or ingest_summary",
+             "category_counts": "ingest_summary", "filter_report": "filter_rooms or filter_report", "symmetry": "symmetry",
+             "nodes": "extract_graphs", "edges": "extract_graphs", "partial_counts": "shard_statistics",
+             "superstructures": "shard_statistics, refine_graphs or gather_graphs",
+             "cooccurrence": "graph_statistics", "relations": "graph_statistics", "hub_patterns": "graph_statistics",
+             "category_sizes": "graph_statistics", "final_nodes": "refine_graphs or gather_graphs",
+             "final_edges": "refine_graphs or gather_graphs"}
+
+
+def _made_by(name: str | None) -> str:
+    rule = PRODUCERS.get(name or "")
+    return f" (written by rule {rule}: rerun it, e.g. snakemake --forcerun {rule.split()[0].rstrip(',')})" if rule else ""
+
+
+def validate_rows(name: str, table: pa.Table) -> None:
+    """Refuse non-finite numbers (any float column, lists included) and duplicate keys (:data:`KEYS`)."""
+    for field in table.schema:
+        t = field.type
+        col = table.column(field.name)
+        if pa.types.is_list(t) and pa.types.is_floating(t.value_type):
+            col = pc.list_flatten(col)
+        elif not pa.types.is_floating(t):
+            continue
+        bad = pc.sum(pc.invert(pc.is_finite(col))).as_py() if len(col) else 0
+        if bad:
+            raise TableError(f"table '{name}': column {field.name} holds {bad} value(s) that are not finite")
+    keys = KEYS.get(name)
+    if keys and table.num_rows:
+        counts = table.group_by(keys).aggregate([([], "count_all")])
+        dup = counts.filter(pc.greater(counts["count_all"], 1))
+        if dup.num_rows:
+            first = {k: dup[k][0].as_py() for k in keys}
+            raise TableError(f"table '{name}': {dup.num_rows} duplicate key(s) ({', '.join(keys)}), e.g. {first}")
+
+
 def empty(name: str) -> pa.Table:
     return SCHEMAS[name].empty_table()
 
@@ -256,6 +309,7 @@ def write(path: str | Path, name: str, table: pa.Table, extra: dict | None = Non
     """Write ``table`` as schema ``name`` to ``path`` atomically (temp file in the same folder, then rename)."""
     path = Path(path)
     table = conform(name, table)
+    validate_rows(name, table)
     table = table.replace_schema_metadata({**(table.schema.metadata or {}), **_metadata(name, extra)})
     return _atomic(path, lambda tmp: pq.write_table(table, tmp, compression="zstd"))
 
@@ -278,7 +332,9 @@ def write_parts(path: str | Path, name: str, parts, extra: dict | None = None) -
         nonlocal rows
         with pq.ParquetWriter(tmp, schema.with_metadata(meta), compression="zstd") as writer:
             for part in parts:
-                writer.write_table(conform(name, part).replace_schema_metadata(meta))
+                part = conform(name, part)
+                validate_rows(name, part)
+                writer.write_table(part.replace_schema_metadata(meta))
                 rows += part.num_rows
 
     _atomic(Path(path), write_to)
@@ -331,9 +387,9 @@ def read(path: str | Path, name: str | None = None, filters=None, columns: list[
         wanted = columns if columns is not None else (SCHEMAS[name].names if name is not None else None)
         return pq.read_table(path, filters=filters, columns=wanted)
     except FileNotFoundError as exc:
-        raise TableError(f"{path}: no such table file") from exc
+        raise TableError(f"{path}: no such table file{_made_by(name)}") from exc
     except (pa.ArrowInvalid, OSError) as exc:
-        raise TableError(f"{path}: not a readable Parquet file: {exc}") from exc
+        raise TableError(f"{path}: not a readable Parquet file{_made_by(name)}: {exc}") from exc
 
 
 def check(path: str | Path, name: str) -> None:
@@ -341,11 +397,11 @@ def check(path: str | Path, name: str) -> None:
     (reads the footer only)."""
     path = Path(path)
     if not path.exists():
-        raise TableError(f"{path}: no such table file")
+        raise TableError(f"{path}: no such table file{_made_by(name)}")
     try:
         present = set(pq.read_schema(path).names)
     except (pa.ArrowInvalid, OSError) as exc:
-        raise TableError(f"{path}: not a readable Parquet file: {exc}") from exc
+        raise TableError(f"{path}: not a readable Parquet file{_made_by(name)}: {exc}") from exc
     missing = [f.name for f in SCHEMAS[name] if f.name not in present]
     if missing:
         raise TableError(f"{path}: table '{name}' lacks field(s) {', '.join(missing)}")

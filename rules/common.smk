@@ -31,9 +31,10 @@ wildcard_constraints:
 
 # ------------------------------------------------------------------------------------------- paths
 INGEST = "results/ingest/shards/{table}-{shard}.parquet"
-INGEST_TABLES = ["rooms", "architecture", "objects", "models", "ground_truth", "ingest_report"]
+INGEST_TABLES = ["rooms", "architecture", "objects", "models", "ground_truth", "ingest_report", "drops"]
 CATEGORY_COUNTS = "results/ingest/category_counts.parquet"
 INGEST_REPORT = "results/ingest/ingest_report.parquet"
+DROPS = "results/ingest/drops.parquet"
 FILTER_ROOMS = "results/filter/shards/rooms-{shard}.parquet"
 FILTER_SHARD_REPORT = "results/filter/shards/report-{shard}.parquet"
 FILTER_REPORT = "results/filter/report.parquet"
@@ -101,6 +102,7 @@ def get_final_outputs():
     return [
         FILTER_REPORT,
         INGEST_REPORT,
+        DROPS,
         *expand(METRICS, corpus="ingested", name=["extraction", "superstructures"]),
         *expand(REPORT, corpus="ingested", name="table1.csv"),
     ]

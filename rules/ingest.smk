@@ -15,7 +15,7 @@ rule ingest:
     shell:
         "planit ingest --shard {wildcards.shard} --config-json {params.config:q} --rooms {output.rooms} "
         "--architecture {output.architecture} --objects {output.objects} --models {output.models} "
-        "--ground-truth {output.ground_truth} --report {output.ingest_report} 2> {log}"
+        "--ground-truth {output.ground_truth} --report {output.ingest_report} --drops {output.drops} 2> {log}"
 
 
 rule ingest_summary:
@@ -24,14 +24,17 @@ rule ingest_summary:
         objects=shards_of(INGEST, table="objects"),
         models=shards_of(INGEST, table="models"),
         reports=shards_of(INGEST, table="ingest_report"),
+        drops=shards_of(INGEST, table="drops"),
     output:
         counts=CATEGORY_COUNTS,
         report=INGEST_REPORT,
+        drops=DROPS,
     params:
         rooms=repeat("--rooms", "rooms"),
         objects=repeat("--objects", "objects"),
         models=repeat("--models", "models"),
         reports=repeat("--report", "reports"),
+        drops=repeat("--drops", "drops"),
     log:
         "logs/ingest_summary/ingest_summary.log",
     benchmark:
@@ -39,8 +42,8 @@ rule ingest_summary:
     conda:
         ENV
     shell:
-        "planit ingest-summary {params.rooms} {params.objects} {params.models} {params.reports} --out-counts {output.counts} "
-        "--out-report {output.report} 2> {log}"
+        "planit ingest-summary {params.rooms} {params.objects} {params.models} {params.reports} {params.drops} "
+        "--out-counts {output.counts} --out-report {output.report} --out-drops {output.drops} 2> {log}"
 
 
 rule filter_rooms:

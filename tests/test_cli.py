@@ -64,7 +64,7 @@ def test_invalid_config_file_names_the_key_in_one_line(tmp_path):
     cfg.write_text("procedural:\n  defect_rate: 2\n")
     o = tmp_path / "i"
     out = planit("ingest", "--shard", "0", "--config", str(cfg), *[a for n in ("rooms", "architecture", "objects", "models",
-                 "ground-truth", "report") for a in (f"--{n}", str(o / f"{n}.parquet"))])
+                 "ground-truth", "report", "drops") for a in (f"--{n}", str(o / f"{n}.parquet"))])
     assert out.returncode == 2 and "procedural.defect_rate" in out.stderr
     assert [line for line in out.stderr.splitlines() if line.startswith("error:")] == [
         f"error: {cfg}: invalid config at key 'procedural.defect_rate': 2 is greater than the maximum of 1"]
@@ -73,7 +73,7 @@ def test_invalid_config_file_names_the_key_in_one_line(tmp_path):
 def test_missing_source_folder_is_a_clear_error(tmp_path):
     o = tmp_path / "i"
     out = planit("ingest", "--shard", "0", "--config-json", '{"source": "front3d", "front3d": {"houses": "/nowhere"}}',
-                 *[a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report")
+                 *[a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report", "drops")
                    for a in (f"--{n}", str(o / f"{n}.parquet"))])
     assert out.returncode == 2 and "front3d" in out.stderr and "/nowhere" in out.stderr and "Traceback" not in out.stderr
 
@@ -95,7 +95,7 @@ def test_only_domain_errors_are_turned_into_one_line():
 def test_strict_keys_expose_a_rule_that_forgets_a_key(tmp_path):
     # the rules run stages with PLANIT_STRICT_KEYS=1: a stage reading a key its rule did not pass fails loudly
     o = tmp_path / "i"
-    args = [a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report")
+    args = [a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report", "drops")
             for a in (f"--{n}", str(o / f"{n}.parquet"))]
     env = {**os.environ, "PLANIT_STRICT_KEYS": "1"}
     out = subprocess.run([PLANIT, "ingest", "--shard", "0", "--config-json", '{"source": "procedural"}', *args],

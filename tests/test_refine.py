@@ -90,6 +90,20 @@ def test_repair_never_revives_the_losing_half_of_a_double_edge():
     assert not out.cyclic
 
 
+def test_connectivity_fallback_edges_carry_every_column_of_a_normal_edge():
+    # o9 has no edge at all: only the fallback from the nearest wall reaches it
+    nodes = [_box_node("o0", "object", "a", cy=1.0), _box_node("o9", "object", "b", cx=3.5, cy=3.5)]
+    nodes += [_box_node(f"wall_{w}", "wall", "wall", cx=2.0, cy=2.0 + w, length=4.0) for w in range(4)]
+    edges = [dict(_edge("wall_0", "o0"), room_type="bedroom")]
+    edges += [dict(_edge(f"wall_{w}", f"wall_{(w + 1) % 4}", "wall_adjacent", "right"), room_type="bedroom") for w in range(4)]
+    out = refine_room(nodes, edges, Stats(hub_patterns={"bedroom": set()}), CFG)
+    fallback = [e for e in out.edges if e["rule"] == "connectivity_fallback"]
+    assert len(fallback) == 1 and fallback[0]["target"] == "o9" and fallback[0]["source"] == "wall_1"  # the nearest
+    normal = next(e for e in out.edges if e["source"] == "wall_0" and e["target"] == "o0")
+    assert set(fallback[0]) == set(normal)
+    assert fallback[0]["room_type"] == "bedroom" and fallback[0]["room_id"] == "r" and fallback[0]["origin"] == "derived"
+
+
 @pytest.mark.parametrize("symmetry, dirs, count, ok", [
     ("left-right", {"left", "right"}, 2, True), ("left-right", {"left", "front"}, 2, False),
     ("radial", {"front"}, 3, True), ("radial", {"front"}, 1, False), ("rotational-2", {"front", "back"}, 2, True),

@@ -56,14 +56,17 @@ def test_front3d_fixture_house(tmp_path):
     reasons = dict(zip(rep.reason, rep["count"]))
     assert reasons["no mesh and no box for its model"] == 1
     assert reasons["room type 'Balcony' not mapped"] == 1 and reasons["no Floor mesh"] == 1
-    assert reasons["box from Models.csv (no raw_model.obj)"] == 1
-    assert any("broken.json: missing field 'mesh'" in r for r in rep.reason)  # reported, run continued
+    assert reasons["box from Models.csv (no usable raw_model.obj)"] == 1
+    drops = t["drops"]
+    broken = drops[drops.file.str.endswith("broken.json")]  # reported with its field, run continued
+    assert broken[["level", "field", "reason"]].values.tolist() == [["house", "mesh", "mesh: missing"]]
     # one WallInner mesh, along the y = 0 wall: one of the four outline walls is backed, three are open
     walls = rep[rep.kind == "wall"].set_index("status")["count"]
     assert (walls["backed"], walls["open"]) == (1, 3)
     # the OBJ was cached: a second run reads the cache, not the file
     cache = front3d.MeshCache(FIX / "front3d/future", tmp_path / "cache")
-    assert cache.get("jid-bed") is not None and (cache.hits, cache.parsed) == (1, 0)
+    mesh, problem = cache.get("jid-bed")
+    assert mesh is not None and problem == "rescaled from cm" and (cache.hits, cache.parsed) == (1, 0)
 
 
 def test_front3d_malformed_wall_mesh_skips_the_house_with_file_and_field(tmp_path):
@@ -74,10 +77,9 @@ def test_front3d_malformed_wall_mesh_skips_the_house_with_file_and_field(tmp_pat
     (houses / "badwall.json").write_text(json.dumps(house))
     t = run_ingest("front3d", {"houses": str(houses), "future": str(FIX / "front3d/future"),
                                "cache_dir": str(tmp_path / "cache")}, tmp_path / "out")
-    rep = t["ingest_report"]
-    skipped = rep[(rep.kind == "house") & (rep.status == "skipped")].reason.tolist()
-    assert len(skipped) == 1 and "badwall.json: mesh wall1: bad 'xyz'" in skipped[0]
-    assert len(t["rooms"]) == 0
+    skipped = t["drops"][t["drops"].level == "house"]
+    assert skipped[["field", "reason"]].values.tolist() == [["mesh[3].xyz", "mesh[3].xyz: bad 'xyz': expected a list of numbers, 3 per vertex"]]
+    assert skipped.file.iloc[0].endswith("badwall.json") and len(t["rooms"]) == 0
 
 
 def test_wall_mesh_coverage_measures_each_outline_edge():
@@ -96,20 +98,18 @@ def test_front3d_quaternion_to_yaw():
     assert front3d.norm_category("Lounge Chair / Cafe Chair") == "lounge chair/cafe chair"
 
 
-def _independent_counts(houses: Path, room_types: dict) -> tuple[int, int]:
-    """Rooms with a Floor mesh, a mapped type and valid furniture; and their valid furniture children."""
-    rooms = objects = 0
+def _independent_counts(houses: Path, room_types: dict) -> dict[str, int]:
+    """Per room with a Floor mesh and a mapped type (its id), the children that place a furniture entry."""
+    out = {}
     for f in sorted(houses.glob("*.json")):
         h = json.loads(f.read_text())
         mesh_types = {m["uid"]: m.get("type") for m in h["mesh"]}
-        furn = {x["uid"]: x for x in h["furniture"]}
+        furn = {x["uid"] for x in h["furniture"]}
         for r in h["scene"]["room"]:
             kids = r.get("children", [])
-            valid = [c for c in kids if furn.get(c.get("ref"), {}).get("valid") and furn[c["ref"]].get("jid")]
-            if r.get("type") in room_types and "Floor" in {mesh_types.get(c.get("ref")) for c in kids} and valid:
-                rooms += 1
-                objects += len(valid)
-    return rooms, objects
+            if r.get("type") in room_types and "Floor" in {mesh_types.get(c.get("ref")) for c in kids}:
+                out[f"{f.stem}_{r['instanceid']}"] = sum(c.get("ref") in furn for c in kids)
+    return out
 
 
 @pytest.mark.realdata
@@ -117,16 +117,17 @@ def test_front3d_real_sample_houses(tmp_path):
     sample = shared_data("3d-front-sample")
     section = {"houses": str(sample / "houses"), "future": str(sample / "3d-future"), "cache_dir": str(tmp_path / "c")}
     t = run_ingest("front3d", section, tmp_path)
-    rooms, objs, rep = t["rooms"], t["objects"], t["ingest_report"]
-    assert not (rep.kind.eq("house") & rep.status.eq("skipped")).any()  # every house parses
+    rooms, objs, drops, rep = t["rooms"], t["objects"], t["drops"], t["ingest_report"]
+    assert not (drops.level == "house").any()  # every house parses
     # every wall of every room read is reported as backed by a WallInner mesh or open; most are backed
     walls = rep[rep.kind == "wall"].set_index("status")["count"]
     assert walls.sum() == (t["architecture"].kind == "wall").sum() and walls["backed"] > walls["open"]
-    want_rooms, want_objects = _independent_counts(sample / "houses", config.validate({})["front3d"]["room_types"])
-    dropped = rep[(rep.kind == "object") & (rep.status == "dropped")]["count"].sum()
-    emptied = rep[(rep.kind == "room") & rep.reason.str.contains("inside the floor outline")]["count"].sum()
-    assert len(rooms) + emptied == want_rooms and emptied <= 1  # one sample room has all its furniture off its floor
-    assert len(objs) + dropped == want_objects
+    want = _independent_counts(sample / "houses", config.validate({})["front3d"]["room_types"])
+    room_drops = set(drops[drops.level == "room"].room_id)
+    assert set(rooms.room_id) | (room_drops & set(want)) == set(want)  # every room read or dropped, with its reason
+    object_drops = drops[drops.level == "object"].groupby("room_id").size()
+    for rid in rooms.room_id:  # every furniture child of a room read became an object or a named drop
+        assert (objs.room_id == rid).sum() + object_drops.get(rid, 0) == want[rid], rid
     for room in rooms.itertuples():
         floor = shapely.Polygon(np.column_stack([room.floor_x, room.floor_y])).buffer(0.05 + 1e-6)
         o = objs[objs.room_id == room.room_id]
@@ -179,7 +180,8 @@ def test_ithor_real_rooms_support_parents_agree(tmp_path):
     ingest.run(cfg, 0, outs)
     rooms = pd.read_parquet(outs["rooms"])
     assert len(rooms) == 120 and Counter(rooms.room_type) == {"bedroom": 30, "living": 30, "kitchen": 30, "bathroom": 30}
-    ingest_summary.run([outs["rooms"]], [outs["objects"]], [outs["models"]], [outs["ingest_report"]], t / "counts.parquet", t / "rep.parquet")
+    ingest_summary.run([outs["rooms"]], [outs["objects"]], [outs["models"]], [outs["ingest_report"]], [outs["drops"]],
+                       t / "counts.parquet", t / "rep.parquet", t / "drops.parquet")
     filter_rooms.run(cfg, outs["rooms"], outs["architecture"], outs["objects"], t / "counts.parquet", t / "kept.parquet",
                      t / "filter.parquet")
     symmetry.run(cfg, [outs["models"]], t / "sym.parquet", t / "sym.json")

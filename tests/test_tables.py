@@ -34,7 +34,7 @@ def test_failed_write_leaves_nothing_behind(tmp_path):
 def test_write_replaces_atomically(tmp_path):
     path = tmp_path / "c.parquet"
     tables.write(path, "architecture", tables.from_rows("architecture", rows()))
-    two = rows() * 2
+    two = rows() + [dict(r, element_id="wall_1") for r in rows()]
     tables.write(path, "architecture", tables.from_rows("architecture", two))
     assert tables.read(path).num_rows == 2
     assert sorted(os.listdir(tmp_path)) == ["c.parquet"]

@@ -4,130 +4,76 @@ A house JSON lists furniture (``uid`` -> 3D-FUTURE ``jid``), architecture meshes
 rooms whose ``children`` reference both. Everything is converted once, here, from 3D-FRONT's Y-up frame to
 the project's Z-up frame: world ``(x, y, z) -> (x, -z, y)``; 3D-FUTURE models face +z, so model space is
 ``(x, y, z) -> (-x, z, y)`` (front = +Y) and an object's yaw gains pi.
+
+Every field is checked where it is read: a malformed house structure skips the house (HouseError, with the
+JSON path of the field), a malformed room skips the room and a malformed furniture entry or placement drops
+that object, each recorded in the ledger's drop rows with the file, ids and JSON path.
 """
 from __future__ import annotations
 
-import csv
-import hashlib
-import json
 import logging
 import math
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
+
+import json
 
 import numpy as np
 import shapely
 from shapely.ops import unary_union
 
-from ..geometry.polygon import (make_ccw, merge_collinear, polygon_segments, segment_distances, segment_interval,
-                                signed_area)
-
 from ..errors import InputError
+from ..geometry.polygon import make_ccw, merge_collinear, polygon_segments, segment_distances, segment_interval, signed_area
+from .future import Catalogue, MeshCache, norm_category
+from .ledger import Ledger
 from .rows import box_model_row, model_row, opening_row, room_row, wall_rows
 
 log = logging.getLogger("planit.front3d")
 
 WORLD = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])  # Y-up world -> Z-up world
-MODEL = np.array([[-1.0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]])  # Y-up model (front +z) -> Z-up model (front +y)
-CM_EXTENT = 5.0  # m: a model whose extent exceeds this is in centimetres
 OPENINGS = {"Door": "door", "Hole": "door", "Window": "window", "BayWindow": "window"}
+ARCHITECTURE_TITLES = ("door/", "window/")  # furniture entries that are openings, not furniture
+__all__ = ["Catalogue", "MeshCache", "HouseError", "parse_house", "norm_category"]
 
 
 class HouseError(InputError):
-    """A house file that cannot be parsed; the message names the file and the field."""
+    """A house file that cannot be parsed; the message names the file and the JSON path of the field."""
+
+    def __init__(self, file, path: str, reason: str) -> None:
+        super().__init__(f"{file}: {path}: {reason}" if path else f"{file}: {reason}")
+        self.file, self.path, self.reason = file, path, reason
 
 
-def norm_category(name: str | None) -> str | None:
-    """3D-FUTURE category as the field writes it: lower case, ' / ' -> '/'."""
-    return None if not name else name.strip().lower().replace(" / ", "/")
+class FieldError(ValueError):
+    """One field of a house JSON is unusable (``path`` is its JSON path)."""
+
+    def __init__(self, path: str, reason: str) -> None:
+        super().__init__(f"{path}: {reason}")
+        self.path, self.reason = path, reason
 
 
-@dataclass
-class Catalogue:
-    """3D-FUTURE model metadata: categories and boxes (model space, Z-up, metres)."""
-    category: dict[str, str] = field(default_factory=dict)
-    box: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
-
-    @classmethod
-    def load(cls, future: Path, models_csv: Path | None, category_csv: Path | None, model_info: Path | None) -> "Catalogue":
-        cat = cls()
-        info = model_info or future / "model_info.json"
-        if info.exists():
-            data = json.loads(info.read_text())
-            if isinstance(data, list):  # the 3D-FUTURE release: [{model_id, category, super-category, ...}]
-                for m in data:
-                    c = norm_category(m.get("category")) or norm_category(m.get("super-category"))
-                    if m.get("model_id") and c:
-                        cat.category[m["model_id"]] = c
-        mapping = category_csv or future / "ModelCategoryMapping.csv"
-        if mapping.exists():
-            with open(mapping, newline="") as fh:
-                for row in csv.DictReader(fh):
-                    c = norm_category(row.get("category")) or norm_category(row.get("super-category"))
-                    if c:
-                        cat.category.setdefault(row["model_id"], c)
-        boxes = models_csv or future / "Models.csv"
-        if boxes.exists():
-            with open(boxes, newline="") as fh:
-                for row in csv.DictReader(fh):
-                    try:
-                        lo = np.array([float(v) for v in row["minPoint"].split(",") if v.strip() != ""])
-                        hi = np.array([float(v) for v in row["maxPoint"].split(",") if v.strip() != ""])
-                    except (KeyError, ValueError) as exc:
-                        raise HouseError(f"{boxes}: model {row.get('id')}: bad minPoint/maxPoint ({exc})") from exc
-                    if lo.shape != (3,) or hi.shape != (3,):
-                        continue  # malformed rows (a few have an empty coordinate) fall back to no box
-                    if (hi - lo).max() > CM_EXTENT:
-                        lo, hi = lo / 100.0, hi / 100.0
-                    corners = np.array([lo, hi]) @ MODEL.T
-                    cat.box[row["id"]] = (corners.min(axis=0), corners.max(axis=0))
-        return cat
+def _numbers(value, n: int, path: str) -> np.ndarray:
+    """``n`` finite numbers from a JSON list, else FieldError."""
+    if not isinstance(value, list) or len(value) != n or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                                  for v in value):
+        raise FieldError(path, f"expected a list of {n} numbers")
+    out = np.asarray(value, float)
+    if not np.isfinite(out).all():
+        raise FieldError(path, "not finite")
+    return out
 
 
-class MeshCache:
-    """3D-FUTURE ``raw_model.obj`` meshes in Z-up model space, parsed once and cached as .npz by file
-    size and modification time, so a re-run does not re-parse OBJ files."""
-
-    def __init__(self, future: Path, cache_dir: Path | None) -> None:
-        self.future = future
-        self.cache_dir = cache_dir
-        self.hits = self.parsed = 0
-
-    def get(self, model_id: str) -> tuple[np.ndarray, np.ndarray, str] | None:
-        path = self.future / model_id / "raw_model.obj"
-        if not path.exists():
-            path = self.future / "models" / model_id / "raw_model.obj"
-        if not path.exists():
-            return None
-        stat = path.stat()
-        key = hashlib.sha1(f"{path.resolve()}:{stat.st_size}:{stat.st_mtime_ns}".encode()).hexdigest()[:16]
-        cached = self.cache_dir / f"{model_id}-{key}.npz" if self.cache_dir else None
-        if cached is not None and cached.exists():
-            with np.load(cached) as z:
-                self.hits += 1
-                return z["v"], z["f"], str(path)
-        import trimesh
-
-        try:
-            mesh = trimesh.load(path, force="mesh", process=False)
-        except Exception as exc:  # trimesh raises many kinds for broken OBJ files
-            log.warning("%s: unreadable mesh (%s); using the box", path, exc)
-            return None
-        v = np.asarray(mesh.vertices, float)
-        f = np.asarray(mesh.faces, np.int64)
-        if len(v) == 0 or len(f) == 0:
-            return None
-        if np.ptp(v, axis=0).max() > CM_EXTENT:
-            v = v / 100.0
-        v = v @ MODEL.T
-        self.parsed += 1
-        if cached is not None:
-            cached.parent.mkdir(parents=True, exist_ok=True)
-            tmp = cached.with_name(cached.name + ".tmp.npz")
-            np.savez_compressed(tmp, v=v.astype(np.float32), f=f.astype(np.int32))
-            tmp.replace(cached)
-        return v, f, str(path)
+def _field(obj: dict, key: str, kind, path: str, default=None):
+    """``obj[key]`` of JSON type ``kind``; missing gives ``default`` unless that is ``...`` (required)."""
+    if key not in obj:
+        if default is ...:
+            raise FieldError(f"{path}.{key}" if path else key, "missing")
+        return default
+    value = obj[key]
+    if not isinstance(value, kind) or isinstance(value, bool) and kind is not bool:
+        raise FieldError(f"{path}.{key}" if path else key, f"expected {getattr(kind, '__name__', kind)}, got {type(value).__name__}")
+    return value
 
 
 def yaw_from_quaternion(q) -> tuple[float, float]:
@@ -154,26 +100,6 @@ def outline_of_triangles(xy_tris: list[np.ndarray]) -> np.ndarray:
     return merge_collinear(make_ccw(outline), tol=1e-3)
 
 
-def _mesh_xyz(mesh: dict, file: Path) -> np.ndarray:
-    """A house mesh's vertices in the project's Z-up world, (n, 3)."""
-    try:
-        return np.asarray(mesh["xyz"], float).reshape(-1, 3) @ WORLD.T
-    except (KeyError, ValueError) as exc:
-        raise HouseError(f"{file}: mesh {mesh.get('uid')}: bad 'xyz' ({exc})") from exc
-
-
-def _outline(floor_meshes: list[dict], file: Path) -> np.ndarray:
-    tris = []
-    for m in floor_meshes:
-        xyz = _mesh_xyz(m, file)
-        try:
-            faces = np.asarray(m["faces"], np.int64).reshape(-1, 3)
-        except (KeyError, ValueError) as exc:
-            raise HouseError(f"{file}: mesh {m.get('uid')}: bad 'faces' ({exc})") from exc
-        tris += [xyz[t, :2] for t in faces]
-    return outline_of_triangles(tris)
-
-
 def wall_mesh_coverage(segs: np.ndarray, footprints: list[np.ndarray], tolerance: float) -> np.ndarray:
     """Share of each outline segment's length (segs: (n, 2, 2)) lying within ``tolerance`` of the floor-plane
     footprint (convex hull of the (k, 2) vertices) of any wall mesh."""
@@ -185,100 +111,177 @@ def wall_mesh_coverage(segs: np.ndarray, footprints: list[np.ndarray], tolerance
     return np.array([line.intersection(band).length / line.length if line.length else 0.0 for line in lines])
 
 
-def _load_house(file: Path) -> dict:
+
+
+# ------------------------------------------------------------------------------------------- houses
+@dataclass
+class Context:
+    """What every house of one ingest job shares: the 3D-FUTURE catalogue and meshes, the ``front3d`` config,
+    the ledger, and the model rows built so far (one per model id, reported once per model)."""
+    catalogue: Catalogue
+    meshes: MeshCache
+    cfg: dict
+    ledger: Ledger
+    models: dict
+
+
+@dataclass
+class House:
+    file: Path
+    uid: str
+    furniture: dict[str, tuple[int, dict]]  # uid -> (index in 'furniture', entry)
+    meshes: dict[str, tuple[int, dict]]  # uid -> (index in 'mesh', mesh)
+    rooms: list  # scene.room
+
+
+def load_house(file: Path, ledger: Ledger) -> House:
+    """The house's structure, checked; duplicate or malformed furniture and mesh entries are dropped (recorded)."""
     try:
         house = json.loads(Path(file).read_text())
-    except (OSError, json.JSONDecodeError) as exc:
-        raise HouseError(f"{file}: not readable JSON ({exc})") from exc
-    for key in ("uid", "furniture", "mesh", "scene"):
-        if key not in house:
-            raise HouseError(f"{file}: missing field '{key}'")
-    if "room" not in house["scene"]:
-        raise HouseError(f"{file}: missing field 'scene.room'")
-    return house
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise HouseError(file, "", f"not readable JSON ({exc})") from exc
+    try:
+        if not isinstance(house, dict):
+            raise FieldError("$", f"expected an object, got {type(house).__name__}")
+        uid = _field(house, "uid", str, "", ...)
+        entries = {}
+        for key in ("furniture", "mesh"):
+            entries[key] = _entries(file, uid, _field(house, key, list, "", ...), key, ledger)
+        rooms = _field(_field(house, "scene", dict, "", ...), "room", list, "scene", ...)
+    except FieldError as exc:
+        raise HouseError(file, exc.path, exc.reason) from exc
+    return House(Path(file), uid, entries["furniture"], entries["mesh"], rooms)
 
 
-def parse_house(file: Path, catalogue: Catalogue, meshes: MeshCache, cfg: dict, report: Counter) -> dict[str, list]:
-    """Rooms of one house as canonical rows: {'rooms', 'architecture', 'objects', 'models'}.
-
-    Rooms without a Floor mesh, of an unmapped type or without valid furniture are skipped (counted in
-    ``report`` with the reason). A malformed house raises HouseError naming the file and field.
-    """
-    house = _load_house(file)
-    furniture = {f["uid"]: f for f in house["furniture"] if "uid" in f}
-    arch_meshes = {m["uid"]: m for m in house["mesh"] if "uid" in m}
-    out = {"rooms": [], "architecture": [], "objects": [], "models": {}}
-    for room in house["scene"]["room"]:
-        rtype_src = room.get("type", "")
-        rtype = cfg["room_types"].get(rtype_src)
-        if rtype is None:
-            report[("room", "skipped", f"room type '{rtype_src}' not mapped")] += 1
-            continue
-        children = room.get("children", [])
-        room_meshes = [arch_meshes[c["ref"]] for c in children if c.get("ref") in arch_meshes]
-        valid = [c for c in children if c.get("ref") in furniture and furniture[c["ref"]].get("valid")
-                 and furniture[c["ref"]].get("jid")]
-        rid = f"{house['uid']}_{room.get('instanceid', rtype_src)}"
-        rows, why = _room(rid, rtype, rtype_src, room_meshes, valid, furniture, catalogue, meshes, out["models"], cfg,
-                          report, file)
-        if rows is None:
-            report[("room", "skipped", why)] += 1
-            continue
-        for k in ("rooms", "architecture", "objects"):
-            out[k] += rows[k]
-        report[("room", "read", rtype)] += 1
+def _entries(file, uid: str, items: list, key: str, ledger: Ledger) -> dict[str, tuple[int, dict]]:
+    """``furniture`` or ``mesh`` entries by uid; an entry that is not an object with a string uid, or repeats a
+    uid (the first is kept), is dropped with its JSON path."""
+    out: dict[str, tuple[int, dict]] = {}
+    level = "object" if key == "furniture" else "mesh"
+    for i, item in enumerate(items):
+        ref = item.get("uid") if isinstance(item, dict) else None
+        if not isinstance(ref, str):
+            ledger.drop(level, f"{key} entry without a string uid", file=file, house=uid, field=f"{key}[{i}]")
+        elif ref in out:
+            ledger.drop(level, f"duplicate {key} uid (the first is kept)", file=file, house=uid, item=ref,
+                        field=f"{key}[{i}].uid")
+        else:
+            out[ref] = (i, item)
     return out
 
 
-def _room(rid, rtype, rtype_src, room_meshes, valid, furniture, catalogue, meshes, models, cfg, report, file):
+def parse_house(file: Path, ctx: Context) -> dict[str, list]:
+    """Rooms of one house as canonical rows: {'rooms', 'architecture', 'objects'} (models go to ``ctx.models``).
+
+    Room ids are ``<file stem>_<instanceid>``: unique across files even when two files hold the same house uid;
+    a room without an instanceid is ``room<index>``, a repeated instanceid gets ``-2``, ``-3``... (reported).
+    """
+    house = load_house(file, ctx.ledger)
+    out = {"rooms": [], "architecture": [], "objects": []}
+    seen: Counter = Counter()
+    for i, room in enumerate(house.rooms):
+        path = f"scene.room[{i}]"
+        if not isinstance(room, dict):
+            ctx.ledger.drop("room", "room entry is not an object", file=file, house=house.uid, field=path)
+            continue
+        name = room.get("instanceid") if isinstance(room.get("instanceid"), str) and room.get("instanceid") else f"room{i}"
+        seen[name] += 1
+        if seen[name] > 1:
+            ctx.ledger[("room", "renamed", "duplicate instanceid in its house: -<n> appended")] += 1
+            name = f"{name}-{seen[name]}"
+        rid = f"{house.file.stem}_{name}"
+        try:
+            rows, why = _room(house, rid, room, path, ctx)
+        except FieldError as exc:
+            rows, why = None, f"bad field: {exc.reason}"
+            ctx.ledger.drop("room", why, file=file, house=house.uid, room=rid, field=exc.path, status="skipped")
+            continue
+        if rows is None:
+            ctx.ledger.drop("room", why, file=file, house=house.uid, room=rid, field=path, status="skipped")
+            continue
+        for k in out:
+            out[k] += rows[k]
+        ctx.ledger[("room", "read", rows["rooms"][0]["room_type"])] += 1
+    return out
+
+
+def _room(house: House, rid: str, room: dict, path: str, ctx: Context):
     """Canonical rows of one room, or (None, reason) for a room that cannot be read."""
-    floors = [m for m in room_meshes if m.get("type") == "Floor"]
+    cfg = ctx.cfg
+    rtype_src = _field(room, "type", str, path, "")
+    rtype = cfg["room_types"].get(rtype_src)
+    if rtype is None:
+        return None, f"room type '{rtype_src}' not mapped"
+    children = [(j, c) for j, c in enumerate(_field(room, "children", list, path, [])) if isinstance(c, dict)]
+    room_meshes = [house.meshes[c["ref"]] for _, c in children if isinstance(c.get("ref"), str) and c["ref"] in house.meshes]
+    floors = [m for m in room_meshes if m[1].get("type") == "Floor"]
     if not floors:
         return None, "no Floor mesh"
-    if not valid:
-        return None, "no valid furniture"
+    placed = [(j, c) for j, c in children if isinstance(c.get("ref"), str) and c["ref"] in house.furniture]
+    if not placed:
+        return None, "no furniture"
     try:
-        outline = _outline(floors, file)
+        outline = outline_of_triangles([t for m in floors for t in _triangles(house, m)])
     except ValueError as exc:
         return None, str(exc)
-    floor_z = min(float(_mesh_xyz(m, file)[:, 2].min()) for m in floors)
-    ceilings = [xyz[:, 2].max() for xyz in (_mesh_xyz(m, file) for m in room_meshes if m.get("type") == "Ceiling")
+    floor_z = min(float(xyz[:, 2].min()) for xyz in (_mesh_xyz(house, m) for m in floors) if len(xyz))
+    ceilings = [xyz[:, 2].max() for xyz in (_mesh_xyz(house, m) for m in room_meshes if m[1].get("type") == "Ceiling")
                 if len(xyz)]
     height = float(max(ceilings)) - floor_z if ceilings else cfg["default_height"]
-    cmap = category_map(cfg, rtype)
-    objects = [o for o in (_object(rid, k, furniture[c["ref"]], c, catalogue, meshes, models, floor_z, cmap, report)
-                           for k, c in enumerate(valid)) if o is not None]
-    floor = shapely.Polygon(outline).buffer(cfg["outside_tolerance"])
-    inside = [o for o in objects if floor.contains(shapely.Point(o["cx"], o["cy"]))]
-    if len(inside) < len(objects):
-        report[("object", "dropped", "centre outside its room's floor outline")] += len(objects) - len(inside)
-    if not inside:
+    where = {"outline": outline, "floor": shapely.Polygon(outline).buffer(cfg["outside_tolerance"]), "floor_z": floor_z,
+             "cmap": category_map(cfg, rtype), "rid": rid}
+    objects = [o for j, c in placed
+               if (o := _object(house, f"{path}.children[{j}]", c, where, ctx)) is not None]
+    if not objects:
         return None, "no furniture with a mesh or box inside the floor outline"
     segs = polygon_segments(outline)
-    _report_walls(segs, room_meshes, cfg, report, file)
-    return {"rooms": [room_row(rid, "front3d", rtype, rtype_src, outline, height, len(inside))],
+    _report_walls(segs, [_mesh_xyz(house, m)[:, :2] for m in room_meshes if m[1].get("type") == "WallInner"], cfg, ctx.ledger)
+    return {"rooms": [room_row(rid, "front3d", rtype, rtype_src, outline, height, len(objects))],
             "architecture": wall_rows(rid, outline, height, cfg["wall_thickness"])
-            + _openings(rid, room_meshes, segs, floor_z, cfg, file),
-            "objects": [dict(o, object_id=f"obj_{k:02d}") for k, o in enumerate(inside)]}, ""
+            + _openings(rid, house, room_meshes, segs, floor_z, cfg),
+            "objects": [dict(o, object_id=f"obj_{k:02d}") for k, o in enumerate(objects)]}, ""
 
 
-def _report_walls(segs: np.ndarray, room_meshes: list[dict], cfg: dict, report: Counter, file: Path) -> None:
+def _mesh_xyz(house: House, mesh: tuple[int, dict]) -> np.ndarray:
+    """A house mesh's vertices in the project's Z-up world, (n, 3); a malformed one skips the house."""
+    i, m = mesh
+    xyz = m.get("xyz")
+    if not isinstance(xyz, list) or len(xyz) % 3:
+        raise HouseError(house.file, f"mesh[{i}].xyz", "bad 'xyz': expected a list of numbers, 3 per vertex")
+    try:
+        return _numbers(xyz, len(xyz), f"mesh[{i}].xyz").reshape(-1, 3) @ WORLD.T
+    except FieldError as exc:
+        raise HouseError(house.file, exc.path, "bad 'xyz': " + exc.reason) from exc
+
+
+def _triangles(house: House, mesh: tuple[int, dict]) -> list[np.ndarray]:
+    """(3, 2) floor-plane triangles of a house mesh; faces out of range or malformed skip the house."""
+    xyz = _mesh_xyz(house, mesh)
+    i, m = mesh
+    faces = m.get("faces")
+    if not isinstance(faces, list) or len(faces) % 3 or not all(isinstance(f, int) and not isinstance(f, bool) for f in faces):
+        raise HouseError(house.file, f"mesh[{i}].faces", "bad 'faces': expected a list of vertex indices, 3 per face")
+    f = np.asarray(faces, np.int64).reshape(-1, 3)
+    if len(f) and (f.min() < 0 or f.max() >= len(xyz)):
+        raise HouseError(house.file, f"mesh[{i}].faces", f"bad 'faces': index out of range (mesh has {len(xyz)} vertices)")
+    return [xyz[t, :2] for t in f]
+
+
+def _report_walls(segs: np.ndarray, wall_footprints: list[np.ndarray], cfg: dict, ledger: Ledger) -> None:
     """Count each outline wall as backed by a WallInner mesh or open."""
-    backed = wall_mesh_coverage(segs, [_mesh_xyz(m, file)[:, :2] for m in room_meshes if m.get("type") == "WallInner"],
-                                cfg["wall_mesh_tolerance"]) >= cfg["wall_mesh_min_coverage"]
-    report[("wall", "backed", "a WallInner mesh runs along it")] += int(backed.sum())
-    report[("wall", "open", "no WallInner mesh along it (open to a neighbour, or the mesh is another room's)")] += int((~backed).sum())
+    backed = wall_mesh_coverage(segs, wall_footprints, cfg["wall_mesh_tolerance"]) >= cfg["wall_mesh_min_coverage"]
+    ledger[("wall", "backed", "a WallInner mesh runs along it")] += int(backed.sum())
+    ledger[("wall", "open", "no WallInner mesh along it (open to a neighbour, or the mesh is another room's)")] += int((~backed).sum())
 
 
-def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: float, cfg: dict,
-              file: Path) -> list[dict]:
+def _openings(rid: str, house: House, room_meshes: list, segs: np.ndarray, floor_z: float, cfg: dict) -> list[dict]:
     """Door and window meshes of the room, projected onto their nearest wall."""
     rows, counts = [], Counter()
-    for m in room_meshes:
-        kind = OPENINGS.get(m.get("type"))
+    for mesh in room_meshes:
+        kind = OPENINGS.get(mesh[1].get("type"))
         if kind is None:
             continue
-        xyz = _mesh_xyz(m, file)
+        xyz = _mesh_xyz(house, mesh)
         if not len(xyz):
             continue
         dist = segment_distances(xyz[:, :2].mean(axis=0), segs)
@@ -288,7 +291,7 @@ def _openings(room_id: str, room_meshes: list[dict], segs: np.ndarray, floor_z: 
         p0, p1 = segment_interval(xyz[:, :2], segs[w])
         if np.linalg.norm(p1 - p0) < cfg["opening_min_width"]:
             continue
-        rows.append(opening_row(room_id, kind, counts[kind], p0, p1, xyz[:, 2].min() - floor_z, xyz[:, 2].max() - floor_z,
+        rows.append(opening_row(rid, kind, counts[kind], p0, p1, xyz[:, 2].min() - floor_z, xyz[:, 2].max() - floor_z,
                                 f"wall_{w}"))
         counts[kind] += 1
     return rows
@@ -300,44 +303,102 @@ def category_map(cfg: dict, room_type: str) -> dict[str, str]:
     return {**maps.get("*", {}), **maps.get(room_type, {})}
 
 
-def _object(room_id, k, furn, child, catalogue, meshes, models, floor_z, cmap, report) -> dict | None:
-    jid = furn["jid"]
-    category = catalogue.category.get(jid) or norm_category(furn.get("category")) or norm_category(furn.get("title"))
-    if not category:
-        report[("object", "dropped", "no category")] += 1
-        return None
-    category = cmap.get(category, category)
-    if jid not in models:
-        mesh = meshes.get(jid)
-        if mesh is not None:
-            models[jid] = model_row(jid, category, "front3d", mesh[0], mesh[1], "mesh", mesh[2])
-        elif jid in catalogue.box:
-            models[jid] = box_model_row(jid, category, "front3d", *catalogue.box[jid])
-            report[("model", "fallback", "box from Models.csv (no raw_model.obj)")] += 1
-        else:
-            report[("object", "dropped", "no mesh and no box for its model")] += 1
-            return None
-    m = models[jid]
+# ------------------------------------------------------------------------------------------- furniture
+def _object(house: House, path: str, child: dict, where: dict, ctx: Context) -> dict | None:
+    """An ``objects`` row for one placed furniture entry, or None: every drop is recorded with its JSON path."""
+    k, furn = house.furniture[child["ref"]]
+    fpath = f"furniture[{k}]"
+    drop = lambda reason, field: ctx.ledger.drop("object", reason, file=house.file, house=house.uid,  # noqa: E731
+                                                 room=where["rid"], item=child["ref"], field=field)
+    title = norm_category(furn.get("title")) or ""
+    jid = furn.get("jid")
+    if furn.get("valid") is False:
+        return drop("not in 3D-FUTURE (valid: false)", f"{fpath}.valid")
+    if not isinstance(jid, str) or not jid:
+        return drop("no model id (jid)", f"{fpath}.jid")
+    if furn.get("valid") is not True and title.startswith(ARCHITECTURE_TITLES):
+        return drop("door or window entry: architecture, not furniture", f"{fpath}.title")
+    category = _category(furn, jid, ctx.catalogue)
+    if category is None:
+        return drop("no category (catalogue, title or super-category)", f"{fpath}.title")
+    blocked = next((p for p in ctx.cfg["not_floor_objects"] if p in category or p in title), None)
+    if blocked is not None:
+        return drop(f"not a floor object ('{blocked}' in its category or title)", f"{fpath}.title")
+    category = where["cmap"].get(category, category)
+    model = _model(jid, category, house, fpath, ctx)
+    if model is None:
+        return drop("no mesh and no box for its model" + ("" if furn.get("valid") else " (no valid flag)"), f"{fpath}.jid")
     try:
-        pos = np.asarray(child["pos"], float) @ WORLD.T
-        yaw, tilt = yaw_from_quaternion(child.get("rot", [0, 0, 0, 1]))
-        sx, sy, sz = (float(s) for s in child.get("scale", [1, 1, 1]))
-    except (KeyError, ValueError, TypeError) as exc:
-        report[("object", "dropped", f"bad pos/rot/scale ({type(exc).__name__})")] += 1
-        return None
+        row, tilt = _placement(where["rid"], model, category, child, path, where["floor_z"], ctx.cfg)
+    except FieldError as exc:
+        return drop(f"bad placement: {exc.reason}", exc.path)
     if tilt > math.radians(5):
-        report[("object", "kept", "tilted more than 5 degrees: yaw kept only")] += 1
+        ctx.ledger[("object", "kept", "tilted more than 5 degrees: yaw kept only")] += 1
+    if not where["floor"].contains(shapely.Point(row["cx"], row["cy"])):
+        return drop("centre outside its room's floor outline", f"{path}.pos")
+    ctx.ledger[("object", "kept", category)] += 1
+    if furn.get("valid") is not True:
+        ctx.ledger[("object", "kept", "no valid flag, but its model has a mesh or box")] += 1
+    return row
+
+
+def _category(furn: dict, jid: str, catalogue: Catalogue) -> str | None:
+    """The catalogue's fine category, else the furniture's own title (its part before ' - '), else the
+    catalogue's super-category, else the entry's category field. A coarse 'others' yields to the title."""
+    title = norm_category(furn.get("title"))
+    title = title.split(" - ")[0].strip() if title else None
+    fine = catalogue.category.get(jid)
+    if fine and fine not in ("others", "other"):
+        return fine
+    return title or fine or catalogue.super_category.get(jid) or norm_category(furn.get("category"))
+
+
+def _model(jid: str, category: str, house: House, fpath: str, ctx: Context) -> dict | None:
+    """The ``models`` row of a 3D-FUTURE model (its mesh, else its Models.csv box), built once per job; every mesh
+    problem is recorded once per model."""
+    if jid in ctx.models:
+        return ctx.models[jid]
+    mesh, problem = ctx.meshes.get(jid)
+    if problem is not None:
+        status = "kept" if mesh is not None else ("fallback" if jid in ctx.catalogue.box else "dropped")
+        ctx.ledger.drop("model", f"mesh {problem}", file=ctx.meshes.path(jid), house=house.uid, item=jid,
+                        field=f"{fpath}.jid", status=status)
+    if mesh is not None:
+        ctx.models[jid] = model_row(jid, category, "front3d", mesh[0], mesh[1], "mesh", mesh[2])
+    elif jid in ctx.catalogue.box:
+        ctx.models[jid] = box_model_row(jid, category, "front3d", *ctx.catalogue.box[jid])
+        ctx.ledger[("model", "fallback", "box from Models.csv (no usable raw_model.obj)")] += 1
+    else:
+        ctx.models[jid] = None  # neither: looked up once, every object using it is dropped
+    return ctx.models[jid]
+
+
+def _placement(rid: str, model: dict, category: str, child: dict, path: str, floor_z: float,
+               cfg: dict) -> tuple[dict, float]:
+    """The object's row (box and pose) from a room child's pos / rot / scale, and its tilt (rad); FieldError for a
+    bad or absurd one."""
+    pos = _numbers(child.get("pos"), 3, f"{path}.pos") @ WORLD.T
+    rot = _numbers(child.get("rot", [0, 0, 0, 1]), 4, f"{path}.rot")
+    if np.linalg.norm(rot) < 1e-6:
+        raise FieldError(f"{path}.rot", "zero quaternion")
+    sx, sy, sz = _numbers(child.get("scale", [1, 1, 1]), 3, f"{path}.scale")
+    lo_s, hi_s = cfg["scale_range"]
+    if not all(lo_s <= abs(v) <= hi_s for v in (sx, sy, sz)):
+        raise FieldError(f"{path}.scale", f"scale {[sx, sy, sz]} outside [{lo_s}, {hi_s}] in magnitude")
+    yaw, tilt = yaw_from_quaternion(rot)
     yaw += math.pi  # Y-up models face +z, ours +y: see the module docstring
     scale = np.array([sx, sz, sy])
-    lo = np.array([m["min_x"], m["min_y"], m["min_z"]])
-    hi = np.array([m["max_x"], m["max_y"], m["max_z"]])
-    centre_local = scale * (lo + hi) / 2
+    lo = np.array([model["min_x"], model["min_y"], model["min_z"]])
+    hi = np.array([model["max_x"], model["max_y"], model["max_z"]])
     half = np.abs(scale) * (hi - lo) / 2
+    min_e, max_e = cfg["object_extent"]
+    if not (2 * half.max() >= min_e and 2 * half.max() <= max_e and 2 * half.min() > 0):
+        raise FieldError(f"{path}.scale", f"size {np.round(2 * half, 4).tolist()} m outside [{min_e}, {max_e}] m")
+    centre_local = scale * (lo + hi) / 2
     c, s = math.cos(yaw), math.sin(yaw)
     p = pos - [0.0, 0.0, floor_z]
     centre = p + [c * centre_local[0] - s * centre_local[1], s * centre_local[0] + c * centre_local[1], centre_local[2]]
-    report[("object", "kept", category)] += 1
-    return {"room_id": room_id, "object_id": f"obj_{k:02d}", "category": category, "model_id": jid,
+    return {"room_id": rid, "object_id": None, "category": category, "model_id": model["model_id"],
             "cx": centre[0], "cy": centre[1], "cz": centre[2], "hx": half[0], "hy": half[1], "hz": half[2],
             "yaw": yaw, "px": p[0], "py": p[1], "pz": p[2], "sx": scale[0], "sy": scale[1], "sz": scale[2],
-            "source_parent_id": None}
+            "source_parent_id": None}, tilt

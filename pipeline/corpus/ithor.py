@@ -80,7 +80,7 @@ def parse_room(group: str, index: int, objects: list[dict], cfg: dict, report: C
     out = {"rooms": [], "architecture": [], "objects": [], "models": [], "ground_truth": []}
     floor = next((o for o in objects if o.get("objectType") == "Floor"), None)
     if floor is None:
-        report[("room", "skipped", "no Floor object")] += 1
+        report.drop("room", "no Floor object", room=rid, status="skipped")
         return out
     fc = _corners(floor)
     floor_z = float(fc[:, 2].max())
@@ -113,24 +113,24 @@ def _object(rid: str, k: int, o: dict, objects: list[dict], outline: np.ndarray,
     t = o.get("objectType")
     if t in WALL_MOUNTED:
         if t != "Floor":
-            report[("object", "dropped", "wall-mounted")] += 1
+            report.drop("object", "wall-mounted", room=rid, item=o.get("objectId"))
         return None
     if t in PARTS:
-        report[("object", "dropped", "part folded into its furniture")] += 1
+        report.drop("object", "part folded into its furniture", room=rid, item=o.get("objectId"))
         return None
     by_type = {x["objectId"]: x.get("objectType") for x in objects}
     if any(by_type.get(p) in HIDDEN_IN for p in o.get("parentReceptacles") or []):
-        report[("object", "dropped", "stored inside a drawer or cabinet")] += 1
+        report.drop("object", "stored inside a drawer or cabinet", room=rid, item=o.get("objectId"))
         return None
     corners = _corners(o)
     if corners is None:
-        report[("object", "dropped", "no bounding box")] += 1
+        report.drop("object", "no bounding box", room=rid, item=o.get("objectId"))
         return None
     corners = corners - [0.0, 0.0, floor_z]
     yaw = -math.radians(float((o.get("rotation") or {}).get("y", 0.0)))
     centre, half = _box(corners, yaw)
     if min(half) <= 1e-3:
-        report[("object", "dropped", "degenerate box")] += 1
+        report.drop("object", "degenerate box", room=rid, item=o.get("objectId"))
         return None
     yaw, centre, half = _face_away_from_wall(yaw, centre, half, corners, outline)
     oid = f"obj_{k:02d}"

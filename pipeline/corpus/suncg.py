@@ -35,10 +35,10 @@ def parse_house(file: Path, room_folder: Path | None, report: Counter) -> dict[s
     try:
         house = json.loads(Path(file).read_text())
     except (OSError, json.JSONDecodeError) as exc:
-        raise HouseError(f"{file}: not readable JSON ({exc})") from exc
+        raise HouseError(file, "", f"not readable JSON ({exc})") from exc
     for key in ("id", "levels"):
         if key not in house:
-            raise HouseError(f"{file}: missing field '{key}'")
+            raise HouseError(file, key, "missing")
     scale = float(house.get("scaleToMeters", 1.0))
     categories = _categories(Path(file).parent / "ModelCategoryMapping.csv")
     out = {"rooms": [], "architecture": [], "objects": [], "models": []}
@@ -48,11 +48,12 @@ def parse_house(file: Path, room_folder: Path | None, report: Counter) -> dict[s
             types = room.get("roomTypes") or []
             rtype = next((ROOM_TYPES[t] for t in types if t in ROOM_TYPES), None)
             if rtype is None:
-                report[("room", "skipped", f"room types {types} not mapped")] += 1
+                report.drop("room", f"room types {types} not mapped", file=file, house=house["id"], room=room.get("id"),
+                            status="skipped")
                 continue
             floor = floor_file(room_folder, house["id"], room.get("modelId", ""))
             if not floor.exists():
-                raise HouseError(f"{file}: room {room.get('id')}: architecture file {floor} not found (SUNCG's room "
+                raise HouseError(file, f"room {room.get('id')}", f"architecture file {floor} not found (SUNCG's room "
                                  "meshes <room modelId>f.obj / w.obj / c.obj are a separate download; set suncg.room_folder)")
             _room(out, house["id"], room, nodes, floor, scale, rtype, categories, report)
     return out
@@ -79,11 +80,12 @@ def _room(out, house_id, room, nodes, floor, scale, rtype, categories, report) -
     objects = []
     for idx in room.get("nodeIndices", []):
         if idx >= len(nodes):
-            report[("object", "dropped", "nodeIndices points past the level's nodes")] += 1
+            report.drop("object", "nodeIndices points past the level's nodes", house=house_id, room=room_id, item=str(idx))
             continue
         n = nodes[idx]
         if n.get("type") != "Object" or not n.get("valid", 1) or "bbox" not in n or "transform" not in n:
-            report[("object", "dropped", "not a valid object with bbox and transform")] += 1
+            report.drop("object", "not a valid object with bbox and transform", house=house_id, room=room_id,
+                        item=n.get("id"))
             continue
         t = np.asarray(n["transform"], float).reshape(4, 4).T  # column-major
         r = WORLD @ t[:3, :3] @ WORLD.T

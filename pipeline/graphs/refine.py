@@ -58,7 +58,8 @@ def refine_room(nodes: list[dict], raw_edges: list[dict], stats: Stats, cfg: dic
     cyclic = _has_cycle(edges)
     out_nodes = _node_roles(nodes, hubs, chains)
     for e in edges:
-        e.setdefault("room_type", room_type)
+        if e.get("room_type") is None:
+            e["room_type"] = room_type
     return Refined(out_nodes, edges, supers, cyclic, repaired)
 
 
@@ -229,8 +230,9 @@ def _repair_connectivity(edges: list[dict], idx: dict, cfg: dict) -> int:
         else:
             wall = _nearest_wall(idx, target)
             e = {k: None for k in edges[0]} if edges else {}
-            e.update(room_id=idx[target]["room_id"], source=wall, target=target, edge_type="spatial", direction="front",
-                     distance="distant", origin="derived", status="kept", rule="connectivity_fallback", group_id=None)
+            e.update(room_id=idx[target]["room_id"], room_type=idx[target]["room_type"], source=wall, target=target,
+                     edge_type="spatial", direction="front", distance="distant", origin="derived", status="kept",
+                     rule="connectivity_fallback", group_id=None)
             edges.append(e)
         repaired += 1
         kept = _kept_graph(edges, idx)

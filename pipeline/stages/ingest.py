@@ -16,25 +16,24 @@ import pyarrow as pa
 from .. import tables
 from ..config import config_hash
 from ..corpus import procedural
+from ..corpus.ledger import Ledger
 from ..errors import InputError
 from ..log import progress
 from ..shards import shard_of
 
 log = logging.getLogger("planit.ingest")
-OUTPUTS = ("rooms", "architecture", "objects", "models", "ground_truth", "ingest_report")
+OUTPUTS = ("rooms", "architecture", "objects", "models", "ground_truth", "ingest_report", "drops")
 
 
-def _tables(rooms, arch, objs, models, gt, report_rows, shard: int) -> dict[str, pa.Table]:
+def _tables(rooms, arch, objs, models, gt, ledger: Ledger, shard: int) -> dict[str, pa.Table]:
     for r in rooms:
         r["shard"] = shard
+    report = [{"source": ledger.source, "item": reason, "kind": kind, "status": status, "reason": reason, "count": n}
+              for (kind, status, reason), n in sorted(ledger.items())]
     return {"rooms": tables.from_rows("rooms", rooms), "architecture": tables.from_rows("architecture", arch),
             "objects": tables.from_rows("objects", objs), "models": tables.from_rows("models", models),
-            "ground_truth": tables.from_rows("ground_truth", gt), "ingest_report": tables.from_rows("ingest_report", report_rows)}
-
-
-def _report_rows(source: str, report: Counter) -> list[dict]:
-    return [{"source": source, "item": reason, "kind": kind,
-             "status": status, "reason": reason, "count": n} for (kind, status, reason), n in sorted(report.items())]
+            "ground_truth": tables.from_rows("ground_truth", gt), "ingest_report": tables.from_rows("ingest_report", report),
+            "drops": tables.from_rows("drops", ledger.drops)}
 
 
 def ingest_procedural(config: dict, shard: int, shards: int) -> dict[str, pa.Table]:
@@ -51,10 +50,10 @@ def ingest_procedural(config: dict, shard: int, shards: int) -> dict[str, pa.Tab
         objs += o
         gt += g
     used = {o["model_id"] for o in objs}
-    report = Counter({("room", "read", rt): n for rt, n in Counter(r["room_type"] for r in rooms).items()})
-    report.update({("category", "found", c): n for c, n in Counter(o["category"] for o in objs).items()})
-    return _tables(rooms, arch, objs, [m for m in model_rows if m["model_id"] in used], gt,
-                   _report_rows("procedural", report), shard)
+    ledger = Ledger("procedural")
+    ledger.update({("room", "read", rt): n for rt, n in Counter(r["room_type"] for r in rooms).items()})
+    ledger.update({("category", "found", c): n for c, n in Counter(o["category"] for o in objs).items()})
+    return _tables(rooms, arch, objs, [m for m in model_rows if m["model_id"] in used], gt, ledger, shard)
 
 
 def _house_files(folder: Path, pattern: str, key: str, limit: int | None, shard: int, shards: int) -> list[Path]:
@@ -75,31 +74,37 @@ def ingest_front3d(config: dict, shard: int, shards: int) -> dict[str, pa.Table]
         raise InputError(f"front3d.future: no such folder '{future}'")
     opt = lambda key: Path(cfg[key]) if cfg[key] else None  # noqa: E731
     catalogue = front3d.Catalogue.load(future, opt("models_csv"), opt("category_csv"), opt("model_info"))
-    cache = front3d.MeshCache(future, opt("cache_dir"))
-    report: Counter = Counter()
-    out = {"rooms": [], "architecture": [], "objects": [], "models": {}}
+    ledger = Ledger("front3d")
+    ctx = front3d.Context(catalogue, front3d.MeshCache(future, opt("cache_dir")), cfg, ledger, {})
+    out = {"rooms": [], "architecture": [], "objects": []}
     for f in progress(files, desc=f"3D-FRONT houses, shard {shard}"):
-        _house(front3d.parse_house, (f, catalogue, cache, cfg, report), out, report)
-    report[("model", "parsed", "OBJ meshes parsed")] += cache.parsed
-    report[("model", "cached", "OBJ meshes read from the cache")] += cache.hits
-    return _tables(out["rooms"], out["architecture"], out["objects"], list(out["models"].values()), [],
-                   _report_rows("front3d", report), shard)
+        _house(front3d.parse_house, (f, ctx), f, out, ledger)
+    ledger[("model", "parsed", "OBJ meshes parsed")] += ctx.meshes.parsed
+    ledger[("model", "cached", "OBJ meshes read from the cache")] += ctx.meshes.hits
+    models = [m for m in ctx.models.values() if m is not None]
+    return _tables(out["rooms"], out["architecture"], out["objects"], models, [], ledger, shard)
 
 
-def _house(parse, args: tuple, out: dict, report: Counter) -> None:
-    """Parse one house into ``out``; a malformed house is skipped and reported with its file and field."""
+def _house(parse, args: tuple, file: Path, out: dict, ledger: Ledger) -> None:
+    """Parse one house into ``out`` inside its own error boundary: whatever goes wrong skips this house, recorded
+    with its file (and the JSON path of the field, where the reader names one); the run goes on."""
     from ..corpus.front3d import HouseError
 
     try:
         parsed = parse(*args)
     except HouseError as exc:
         log.warning("house skipped: %s", exc)
-        report[("house", "skipped", str(exc))] += 1
+        ledger.drop("house", f"{exc.path}: {exc.reason}" if exc.path else exc.reason, file=file, field=exc.path or None,
+                    status="skipped")
         return
-    report[("house", "read", "ok")] += 1
+    except Exception as exc:  # noqa: BLE001 - the boundary: one odd house never stops the run (traceback logged)
+        log.warning("house skipped: %s: unexpected %s: %s", file, type(exc).__name__, exc, exc_info=True)
+        ledger.drop("house", f"unexpected {type(exc).__name__}: {exc}", file=file, status="skipped")
+        return
+    ledger[("house", "read", "ok")] += 1
     for k, rows in parsed.items():
         if isinstance(out[k], dict):  # models, by id: the first house to use a model defines its row
-            for row in (rows.values() if isinstance(rows, dict) else rows):
+            for row in rows:
                 out[k].setdefault(row["model_id"], row)
         else:
             out[k] += rows
@@ -110,17 +115,16 @@ def ingest_ithor(config: dict, shard: int, shards: int) -> dict[str, pa.Table]:
 
     cfg = config["ithor"]
     data, path = ithor.load(cfg)
-    report: Counter = Counter()
+    ledger = Ledger("ithor")
     out = {k: [] for k in ("rooms", "architecture", "objects", "models", "ground_truth")}
     for group in cfg["groups"]:
         if group not in data or group not in ithor.GROUPS:
             raise InputError(f"{path}: no room group '{group}' (ithor.groups; known: {sorted(ithor.GROUPS)})")
         mine = [(k, objects) for k, objects in enumerate(data[group]) if shard_of(ithor.room_id(group, k), shards) == shard]
         for k, objects in progress(mine, desc=f"AI2-THOR {group}, shard {shard}"):
-            for name, rows in ithor.parse_room(group, k, objects, cfg, report).items():
+            for name, rows in ithor.parse_room(group, k, objects, cfg, ledger).items():
                 out[name] += rows
-    return _tables(out["rooms"], out["architecture"], out["objects"], out["models"], out["ground_truth"],
-                   _report_rows("ithor", report), shard)
+    return _tables(out["rooms"], out["architecture"], out["objects"], out["models"], out["ground_truth"], ledger, shard)
 
 
 def ingest_suncg(config: dict, shard: int, shards: int) -> dict[str, pa.Table]:
@@ -129,15 +133,15 @@ def ingest_suncg(config: dict, shard: int, shards: int) -> dict[str, pa.Table]:
     cfg = config["suncg"]
     files = _house_files(Path(cfg["houses"]), "*/house.json", "suncg.houses", None, shard, shards)
     room_folder = Path(cfg["room_folder"]) if cfg["room_folder"] else None
-    report: Counter = Counter()
+    ledger = Ledger("suncg")
     out = {"rooms": [], "architecture": [], "objects": [], "models": {}}
     for f in progress(files, desc=f"SUNCG houses, shard {shard}"):
-        _house(suncg.parse_house, (f, room_folder, report), out, report)
+        _house(suncg.parse_house, (f, room_folder, ledger), f, out, ledger)
     if files and not out["rooms"]:
-        reasons = "; ".join(r for (kind, status, r) in report if kind == "house" and status == "skipped")
+        reasons = "; ".join(f"{d['file']}: {d['field'] + ': ' if d['field'] else ''}{d['reason']}"
+                            for d in ledger.drops if d["level"] == "house")
         raise InputError(f"source suncg: no room could be read: {reasons}")
-    return _tables(out["rooms"], out["architecture"], out["objects"], list(out["models"].values()), [],
-                   _report_rows("suncg", report), shard)
+    return _tables(out["rooms"], out["architecture"], out["objects"], list(out["models"].values()), [], ledger, shard)
 
 
 SOURCES = {"procedural": ingest_procedural, "front3d": ingest_front3d, "ithor": ingest_ithor, "suncg": ingest_suncg}
@@ -154,6 +158,8 @@ def run(config: dict, shard: int, outputs: dict[str, Path]) -> dict[str, int]:
         tables.write(outputs[name], name, result[name], extra)
     counts = {name: result[name].num_rows for name in OUTPUTS}
     log.info("ingested %s shard %d: %s", source, shard, counts)
+    for reason, n in Counter(d["reason"] for d in result["drops"].to_pylist()).most_common(5):
+        print(f"  shard {shard}: dropped {n} x {reason}", flush=True)
     for row in result["ingest_report"].to_pylist():
         log.info("  %-8s %-9s %6d  %s", row["kind"], row["status"], row["count"], row["reason"] or row["item"])
     return counts

@@ -3,7 +3,10 @@ needs, and the ingest report summed over shards."""
 from __future__ import annotations
 
 import logging
+from collections import Counter
 from pathlib import Path
+
+import pyarrow as pa
 
 
 from .. import duck, tables
@@ -12,10 +15,10 @@ from ..errors import InputError
 log = logging.getLogger("planit.ingest")
 
 
-def run(rooms: list[Path], objects: list[Path], models: list[Path], reports: list[Path], out_counts: Path,
-        out_report: Path) -> dict:
-    """Write ``category_counts`` and the summed ``ingest_report`` (plus the distinct models over every shard); no
-    room ingested at all is an error."""
+def run(rooms: list[Path], objects: list[Path], models: list[Path], reports: list[Path], drops: list[Path],
+        out_counts: Path, out_report: Path, out_drops: Path) -> dict:
+    """Write ``category_counts``, the summed ``ingest_report`` (plus the distinct models over every shard) and every
+    shard's ``drops`` in one table; print the top drop reasons. No room ingested at all is an error."""
     room_t = tables.read_many(rooms, "rooms", columns=["room_id", "room_type"])
     if room_t.num_rows == 0:
         raise InputError(f"no room was ingested from any of the {len(rooms)} shard(s): see the ingest reports "
@@ -38,8 +41,24 @@ def run(rooms: list[Path], objects: list[Path], models: list[Path], reports: lis
                count(DISTINCT model_id)
         FROM m HAVING count(*) > 0
         ORDER BY kind, status, item""").to_arrow_table()
+    drop_t = tables.read_many(drops, "drops")
     tables.write(out_counts, "category_counts", counts)
     tables.write(out_report, "ingest_report", report)
-    summary = {"rooms": room_t.num_rows, "categories": counts.num_rows}
+    tables.write(out_drops, "drops", drop_t)
+    summary = {"rooms": room_t.num_rows, "categories": counts.num_rows, "dropped": drop_t.num_rows}
+    _print_drops(drop_t, out_drops)
     log.info("ingest summary: %s", summary)
     return summary
+
+
+def _print_drops(drops: pa.Table, path: Path, top: int = 5) -> None:
+    """The console summary: how many of each level were dropped, the top reasons, and where the table is."""
+    if not drops.num_rows:
+        print("ingest: nothing dropped", flush=True)
+        return
+    rows = drops.select(["level", "reason"]).to_pylist()
+    levels = Counter(r["level"] for r in rows)
+    print(f"ingest: dropped {', '.join(f'{n} {lvl}(s)' for lvl, n in levels.most_common())}; every one, with its file, "
+          f"ids and field, in {path} (planit stats {path})", flush=True)
+    for (level, reason), n in Counter((r["level"], r["reason"]) for r in rows).most_common(top):
+        print(f"  {n:6d} {level}: {reason}", flush=True)

@@ -1,0 +1,22 @@
+"""What an ingest job did: the report's counts and one row per dropped house, room, object or model."""
+from __future__ import annotations
+
+from collections import Counter
+
+
+class Ledger(Counter):
+    """Counts keyed ``(level, status, reason)`` (the ingest report) plus ``drops``: one row per item dropped or
+    skipped, naming the source file, the house, room and item ids and the JSON path of the field at fault."""
+
+    def __init__(self, source: str) -> None:
+        super().__init__()
+        self.source = source
+        self.drops: list[dict] = []
+
+    def drop(self, level: str, reason: str, *, file=None, house=None, room=None, item=None, field=None,
+             status: str = "dropped") -> None:
+        """Count and record one dropped ``level`` (house | room | object | model | mesh)."""
+        self[(level, status, reason)] += 1
+        self.drops.append({"source": self.source, "file": None if file is None else str(file), "house_id": house,
+                           "room_id": room, "item_id": item, "level": level, "status": status, "field": field,
+                           "reason": reason})
