@@ -140,7 +140,7 @@ SCHEMAS: dict[str, pa.Schema] = {
         _f("room_id", _STR, doc="the room (for rooms, objects: the id it would have had)"),
         _f("item_id", _STR, doc="object: furniture uid / object id; model: model id; mesh: mesh uid"),
         _f("level", _CAT, doc="house | room | object | model | mesh"),
-        _f("status", _CAT, doc="dropped | skipped | fallback (a model replaced by its box)"),
+        _f("status", _CAT, doc="dropped | skipped | fallback (a model replaced by its box) | kept (a mesh kept after a fix)"),
         _f("field", _STR, doc="JSON path of the field at fault, e.g. scene.room[2].children[5].pos"),
         _f("reason", _STR),
     ]),
