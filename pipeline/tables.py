@@ -129,7 +129,7 @@ SCHEMAS: dict[str, pa.Schema] = {
         _f("source", _CAT),
         _f("item", _STR, doc="house / room / object / model the row is about"),
         _f("kind", _CAT, doc="house | room | wall | object | model | category"),
-        _f("status", _CAT, doc="read | skipped | kept | dropped | fallback | found | backed | open"),
+        _f("status", _CAT, doc="read | skipped | kept | dropped | fallback | found | backed | open | renamed | uid (item: a house uid read, reason: its file) | duplicate uid"),
         _f("reason", _STR),
         _f("count", pa.int64()),
     ]),

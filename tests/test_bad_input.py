@@ -78,6 +78,14 @@ def test_same_house_uid_in_two_files_and_repeated_ids_stay_unique(tmp_path):
     assert not t["objects"].duplicated(["room_id", "object_id"]).any()
     dup = drops_of(t, "object")
     assert dup[dup.reason.str.startswith("duplicate furniture uid")].field.tolist() == ["furniture[4].uid"]
+    out = tmp_path / "out"
+    summary = tmp_path / "summary"
+    ingest_summary.run([out / "rooms.parquet"], [out / "objects.parquet"], [out / "models.parquet"],
+                       [out / "ingest_report.parquet"], [out / "drops.parquet"], summary / "c.parquet",
+                       summary / "r.parquet", summary / "d.parquet")
+    rep = pd.read_parquet(summary / "r.parquet")
+    twins = rep[rep.status == "duplicate uid"]
+    assert twins.item.tolist() == [BASE["uid"]] and twins["count"].tolist() == [2] and "a.json" in twins.reason.iloc[0]
 
 
 @pytest.mark.parametrize("field, value, reason", [

@@ -202,7 +202,7 @@ def parse_house(file: Path, ctx: Context) -> dict[str, list]:
         for k in out:
             out[k] += rows[k]
         ctx.ledger[("room", "read", rows["rooms"][0]["room_type"])] += 1
-    return out
+    return {**out, "house_id": house.uid}
 
 
 def _room(house: House, rid: str, room: dict, path: str, ctx: Context):

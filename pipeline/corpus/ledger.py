@@ -12,6 +12,7 @@ class Ledger(Counter):
         super().__init__()
         self.source = source
         self.drops: list[dict] = []
+        self.houses: list[tuple[str, str]] = []  # (house uid, file) of every house read
 
     def drop(self, level: str, reason: str, *, file=None, house=None, room=None, item=None, field=None,
              status: str = "dropped") -> None:

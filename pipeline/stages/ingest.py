@@ -30,6 +30,8 @@ def _tables(rooms, arch, objs, models, gt, ledger: Ledger, shard: int) -> dict[s
         r["shard"] = shard
     report = [{"source": ledger.source, "item": reason, "kind": kind, "status": status, "reason": reason, "count": n}
               for (kind, status, reason), n in sorted(ledger.items())]
+    report += [{"source": ledger.source, "item": uid, "kind": "house", "status": "uid", "reason": str(file), "count": 1}
+               for uid, file in sorted(ledger.houses)]
     return {"rooms": tables.from_rows("rooms", rooms), "architecture": tables.from_rows("architecture", arch),
             "objects": tables.from_rows("objects", objs), "models": tables.from_rows("models", models),
             "ground_truth": tables.from_rows("ground_truth", gt), "ingest_report": tables.from_rows("ingest_report", report),
@@ -102,6 +104,8 @@ def _house(parse, args: tuple, file: Path, out: dict, ledger: Ledger) -> None:
         ledger.drop("house", f"unexpected {type(exc).__name__}: {exc}", file=file, status="skipped")
         return
     ledger[("house", "read", "ok")] += 1
+    if parsed.get("house_id"):
+        ledger.houses.append((parsed.pop("house_id"), str(file)))
     for k, rows in parsed.items():
         if isinstance(out[k], dict):  # models, by id: the first house to use a model defines its row
             for row in rows:

@@ -7,6 +7,7 @@ from collections import Counter
 from pathlib import Path
 
 import pyarrow as pa
+import pyarrow.compute  # noqa: F401  (pa.compute)
 
 
 from .. import duck, tables
@@ -26,7 +27,15 @@ def run(rooms: list[Path], objects: list[Path], models: list[Path], reports: lis
     con = duck.connect()
     con.register("r", room_t)
     con.register("o", tables.read_many(objects, "objects", columns=["room_id", "category"]))
-    con.register("rep", tables.read_many(reports, "ingest_report"))
+    con.register("shard_rep", tables.read_many(reports, "ingest_report"))
+    # a house uid read from more than one file: its rooms stay apart (room ids start with the file name); reported
+    con.execute("""
+        CREATE VIEW rep AS
+        SELECT * FROM shard_rep WHERE NOT (kind = 'house' AND status = 'uid')
+        UNION ALL
+        SELECT any_value(source), item, 'house', 'duplicate uid',
+               'the same house uid in ' || count(*) || ' files: ' || string_agg(reason, ', ' ORDER BY reason), count(*)
+        FROM shard_rep WHERE kind = 'house' AND status = 'uid' GROUP BY item HAVING count(*) > 1""")
     con.register("m", tables.read_many(models, "models", columns=["model_id", "source"]))
     counts = con.sql("""
         SELECT CAST(r.room_type AS VARCHAR) room_type, CAST(o.category AS VARCHAR) category,
@@ -47,6 +56,8 @@ def run(rooms: list[Path], objects: list[Path], models: list[Path], reports: lis
     tables.write(out_drops, "drops", drop_t)
     summary = {"rooms": room_t.num_rows, "categories": counts.num_rows, "dropped": drop_t.num_rows}
     _print_drops(drop_t, out_drops)
+    for row in report.filter(pa.compute.equal(report["status"], "duplicate uid")).to_pylist():
+        print(f"ingest: house {row['item']}: {row['reason']} (rooms kept apart by file name)", flush=True)
     log.info("ingest summary: %s", summary)
     return summary
 
