@@ -262,7 +262,7 @@ def anchor_sides(b: np.ndarray, walls: Walls, sp: dict) -> dict[str, np.ndarray]
 
 
 def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Split every side at the projected endpoints of the footprints it may see (same group, not itself,
+    """Split every side at the projected corners of the footprints it may see (same group, not itself,
     not wholly behind its ray origins). Returns ``piece_side (p,)``, ``starts (p,)``, ``ends (p,)``."""
     owners = sides["owner"]
     o = len(all_fp)
@@ -273,8 +273,9 @@ def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarra
     half = sides["half"][:, None]
     live = ((group[None, :] == group[owners][:, None]) & (np.arange(o)[None, :] != owners[:, None])
             & (d.max(axis=2) > -sides["inset"][:, None]) & (hi > -half) & (lo < half))
-    cuts = np.concatenate([-half, half, np.where(live, np.clip(lo, -half, half), np.nan),
-                           np.where(live, np.clip(hi, -half, half), np.nan)], axis=1)
+    # every projected corner is a cut: within a piece each footprint's near boundary is one straight edge
+    corner_cuts = np.where(live[:, :, None], np.clip(t, -half[:, :, None], half[:, :, None]), np.nan)
+    cuts = np.concatenate([-half, half, corner_cuts.reshape(len(owners), -1)], axis=1)
     cuts = np.sort(cuts, axis=1)  # NaN sort last
     starts, ends = cuts[:, :-1], cuts[:, 1:]
     valid = np.isfinite(ends) & (ends - starts > 1e-6)
@@ -298,10 +299,15 @@ def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
     key = piece_side[ok] * total + p_owner[ok]
     uniq, inv = np.unique(key, return_inverse=True)
     vis = np.bincount(inv, weights=(ends - starts)[ok], minlength=len(uniq))
+    # Embree decides which target each piece sees; geometry decides how far: the exact clearance of the target's
+    # footprint within the piece (rays start inside the anchor, so a target reaching past them is hit from inside)
+    ps = piece_side[ok]
+    clear = relations.strip_clearance(all_fp[p_owner[ok]], sides["centre"][ps], sides["tangent"][ps],
+                                      sides["normal"][ps], starts[ok], ends[ok])
+    clear = np.where(np.isfinite(clear), clear, p_dist[ok] - sides["inset"][ps])
     gap = np.full(len(uniq), np.inf)
-    np.minimum.at(gap, inv, p_dist[ok])
+    np.minimum.at(gap, inv, clear)
     u_side, u_target = uniq // total, uniq % total
-    gap -= sides["inset"][u_side]
     proj = np.einsum("mkj,mj->mk", all_fp[u_target], sides["tangent"][u_side])
     target_share = np.minimum(vis / np.maximum(np.ptp(proj, axis=1), 1e-9), 1.0)
     anchor_share = np.minimum(vis / (2 * sides["half"][u_side]), 1.0)

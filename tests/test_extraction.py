@@ -3,6 +3,7 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from pipeline.corpus import catalog
 from pipeline.geometry import relations
@@ -182,3 +183,110 @@ def test_box_contact_rules_for_box_only_sources():
     cfg["extract"]["support"]["inside_box_contact"] = False
     parents = {n["node_id"]: n["parent_id"] for n in r.extract(cfg=cfg["extract"]).nodes}
     assert parents["pillow"] is None and parents["sink"] is None
+
+
+# ------------------------------------------------------------------ exact gaps: flush, overlapping, turned (issue 11)
+def square_room(size=4.0):
+    return Room([[0, 0], [size, 0], [size, size], [0, size]])
+
+
+@pytest.mark.parametrize("push", [0.0, 0.005, 0.02, 0.05, 0.10])
+def test_cabinet_pushed_into_the_wall_is_adjacent_with_the_overlap_as_gap(push):
+    r = square_room()
+    r.add("cab", "cabinet", (1.0, 0.5, 0.9), (0.25 - push, 2.0), yaw_deg=-90)  # back to the x = 0 wall (wall_3)
+    e = edge(r.extract(), "wall_3", "cab")
+    assert e["distance"] == "adjacent" and e["gap"] == pytest.approx(-push, abs=1e-6)
+
+
+@pytest.mark.parametrize("overlap", [0.0, 0.001, 0.2])
+def test_lamp_flush_with_or_into_the_sofa_front_is_adjacent(overlap):
+    r = square_room(6.0)
+    r.add("sofa", "sofa", (2.0, 1.0, 0.8), (3.0, 1.0))  # front (+y) at y = 1.5
+    r.add("lamp", "floor_lamp", (0.6, 0.6, 1.6), (3.0, 1.8 - overlap))
+    e = edge(r.extract(), "sofa", "lamp")
+    assert (e["direction"], e["distance"]) == ("front", "adjacent") and e["gap"] == pytest.approx(-overlap, abs=1e-6)
+
+
+@pytest.mark.parametrize("yaw", [0.0, 10.0, 30.0, 45.0, 77.0])
+def test_turned_chair_gap_is_its_nearest_corner(yaw):
+    from pipeline.geometry.boxes import footprint_corners
+
+    hx, hy = 0.243, 0.294
+    corners = footprint_corners(0.0, 0.0, hx, hy, math.radians(yaw))[0]
+    cx = 0.40 - corners[:, 0].min()  # nearest corner 0.40 m from the x = 0 wall
+    r = square_room()
+    r.add("chair", "chair", (2 * hx, 2 * hy, 0.9), (cx, 2.0), yaw_deg=yaw)
+    e = edge(r.extract(), "wall_3", "chair")
+    assert e["gap"] == pytest.approx(0.400, abs=1e-6) and e["distance"] == "proximal"
+
+
+def _side(box, direction):
+    """(centre, tangent, normal, half length, depth) of one side of an oriented box, built independently of the
+    extraction code."""
+    cx, cy, hx, hy, yaw = box
+    c, s = math.cos(yaw), math.sin(yaw)
+    ex, ey = np.array([c, s]), np.array([-s, c])  # local x (right) and y (front) in the world
+    normal = {"front": ey, "back": -ey, "left": -ex, "right": ex}[direction]
+    half_depth, half_len = (hy, hx) if direction in ("front", "back") else (hx, hy)
+    return np.array([cx, cy]) + normal * half_depth, np.array([normal[1], -normal[0]]), normal, half_len, 2 * half_depth
+
+
+def _exact_gap(anchor, target_poly, direction, inset_fraction=0.1, inset_max=0.45, samples=201):
+    """Smallest clearance along the side's normal from the anchor side to the part of the target it sees (sampling
+    with shapely at many positions along the side, the target's corners among them: at each, the target's near
+    edge; positions where the whole target lies behind the ray origins, inside the anchor, are not seen)."""
+    import shapely
+
+    centre, tangent, normal, half, depth = _side(anchor, direction)
+    inset = min(inset_fraction * depth, inset_max)
+    corners = (np.asarray(target_poly.exterior.coords)[:-1] - centre) @ tangent
+    ts = np.unique(np.concatenate([np.linspace(-half, half, samples), np.clip(corners, -half, half)]))
+    lines = shapely.linestrings([[centre + t * tangent - 50 * normal, centre + t * tangent + 50 * normal] for t in ts])
+    cuts = shapely.intersection(lines, target_poly)
+    best = np.inf
+    for t, cut in zip(ts, cuts):
+        if cut.is_empty:
+            continue
+        d = (np.asarray(shapely.get_coordinates(cut)) - centre) @ normal
+        if d.max() >= -inset:
+            best = min(best, d.min())
+    return best
+
+
+@st.composite
+def anchor_target_pairs(draw):
+    f = st.floats(0.1, 0.8)
+    anchor = (3.0, 3.0, draw(f), draw(f), math.radians(draw(st.floats(0, 360))))
+    phi, r = math.radians(draw(st.floats(0, 360))), draw(st.floats(0.2, 2.2))
+    target = (3.0 + r * math.cos(phi), 3.0 + r * math.sin(phi), draw(f), draw(f), math.radians(draw(st.floats(0, 360))))
+    snap = draw(st.sampled_from([None, 0.0, -0.004, -0.02, 0.003]))  # flush with / into / just off the anchor's front
+    return anchor, target, snap
+
+
+@given(anchor_target_pairs())
+def test_reported_gap_is_the_exact_clearance_for_any_yaw_and_overlap(pair):
+    import shapely
+    from hypothesis import assume
+    from pipeline.geometry.boxes import footprint_corners, penetration_depths
+
+    anchor, target, snap = pair
+    poly = lambda b: shapely.Polygon(footprint_corners(b[0], b[1], b[2], b[3], b[4])[0])  # noqa: E731
+    if snap is not None:  # slide the target along the anchor's front normal to a chosen clearance
+        g = _exact_gap(anchor, poly(target), "front")
+        assume(np.isfinite(g))
+        n = _side(anchor, "front")[2]
+        target = (target[0] + (snap - g) * n[0], target[1] + (snap - g) * n[1], *target[2:])
+    boxes7 = np.array([[b[0], b[1], 0.5, b[2], b[3], 0.5, b[4]] for b in (anchor, target)])
+    inset_min = min(0.1 * 2 * min(anchor[2], anchor[3]), 0.1 * 2 * min(target[2], target[3]))
+    assume(penetration_depths(boxes7)[0, 1] < 0.5 * inset_min)  # not deeper into each other than the ray origins
+    assume(all(0.2 < v < 5.8 for b in (anchor, target) for v in footprint_corners(b[0], b[1], b[2], b[3], b[4]).ravel()))
+    r = Room([[0, 0], [6, 0], [6, 6], [0, 6]])
+    r.add("a", "crate", (2 * anchor[2], 2 * anchor[3], 1.0), anchor[:2], yaw_deg=math.degrees(anchor[4]))
+    r.add("t", "crate", (2 * target[2], 2 * target[3], 1.0), target[:2], yaw_deg=math.degrees(target[4]))
+    g = r.extract()
+    for src, dst, box, tpoly in (("a", "t", anchor, poly(target)), ("t", "a", target, poly(anchor))):
+        e = edge(g, src, dst)
+        if e is None:
+            continue
+        exact = _exact_gap(box, tpoly, e["direction"])
+        assert e["gap"] == pytest.approx(exact, abs=1e-3), (src, e["direction"], e["gap"], exact)

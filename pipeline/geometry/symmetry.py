@@ -51,9 +51,9 @@ class Invariances:
 
     def __getitem__(self, name: str) -> bool:
         if name not in self.known:
-            moved = self.points @ TRANSFORMS[name].T
-            d1 = self.tree.query(moved)[0]
-            d2 = cKDTree(moved).query(self.points)[0]
+            m = TRANSFORMS[name]  # orthogonal: the distance from p to the moved surface M q is |M^T p - q|
+            d1 = self.tree.query(self.points @ m.T)[0]  # moved samples -> surface
+            d2 = self.tree.query(self.points @ m)[0]  # samples -> moved surface, without a second tree
             self.known[name] = float(max(d1.mean(), d2.mean())) <= self.limit
         return self.known[name]
 
