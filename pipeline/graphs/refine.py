@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 
-from .superstructures import DIRECTION_PREFERENCE, Chain, Hub, find_chains, hub_candidates, node_index, select_hubs
+from .superstructures import DIRECTION_PREFERENCE, Chain, Hub, node_index, room_candidates, select_hubs
 
 ARCHITECTURE_EDGES = ("wall_adjacent", "wall_opposite", "opening")
 UNIQUE_FRONT = ("none", "left-right")
@@ -42,11 +42,7 @@ def refine_room(nodes: list[dict], raw_edges: list[dict], stats: Stats, cfg: dic
     room_type = nodes[0]["room_type"] if nodes else ""
     idx = node_index(nodes)
     edges = [dict(e, status="kept", rule=None, origin="raw", group_id=None) for e in raw_edges]
-    if candidates is None:
-        spatial = [e for e in edges if e["edge_type"] == "spatial"]
-        chains = find_chains(idx, spatial, cfg)
-        candidates = (chains, hub_candidates(idx, spatial, cfg, {m: k for k, c in enumerate(chains) for m in c.members}))
-    chains, hub_cands = candidates
+    chains, hub_cands = candidates if candidates is not None else room_candidates(idx, edges, cfg)
     hubs = select_hubs(hub_cands, idx, stats.hub_patterns.get(room_type, set()))
     supers = _mark_superstructures(edges, hubs, chains)
     _resolve_double_edges(edges, idx, stats, room_type)

@@ -10,7 +10,7 @@ from pathlib import Path
 import pandas as pd
 
 from .. import duck
-from .superstructures import Chain, Hub, find_chains, hub_candidates, node_index
+from .superstructures import Chain, Hub, node_index, room_candidates
 
 PARTIAL_KEYS = ["kind", "room_type", "cat_a", "cat_b", "direction", "distance"]
 
@@ -56,10 +56,7 @@ def candidates(rooms, cfg: dict) -> tuple[list[dict], Counter]:
             continue
         idx = node_index(nodes)
         room_id, room_type = nodes[0]["room_id"], nodes[0]["room_type"]
-        spatial = [e for e in edges if e["edge_type"] == "spatial"]
-        chains = find_chains(idx, spatial, cfg)
-        chain_of = {m: k for k, c in enumerate(chains) for m in c.members}
-        hubs = hub_candidates(idx, spatial, cfg, chain_of)
+        chains, hubs = room_candidates(idx, edges, cfg)
         for h in hubs:
             patterns[(room_type, idx[h.hub]["category"], idx[h.spokes[0]]["category"])] += 1
         rows += [dict(r, room_id=room_id, room_type=room_type) for r in candidate_rows(chains, hubs)]

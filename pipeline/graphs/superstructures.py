@@ -84,6 +84,14 @@ def hub_candidates(nodes: dict[str, dict], edges: list[dict], cfg: dict, exclude
     return hubs
 
 
+def room_candidates(nodes: dict[str, dict], edges: list[dict], cfg: dict) -> tuple[list["Chain"], list[Hub]]:
+    """A room's chains and hub candidates (spokes never chain-mates of their hub): what the statistics map step
+    writes and refinement reads."""
+    spatial = [e for e in edges if e["edge_type"] == "spatial"]
+    chains = find_chains(nodes, spatial, cfg)
+    return chains, hub_candidates(nodes, spatial, cfg, {m: k for k, c in enumerate(chains) for m in c.members})
+
+
 def select_hubs(candidates: list[Hub], nodes: dict[str, dict], accepted: set[tuple[str, str]]) -> list[Hub]:
     """Keep candidates whose (hub category, spoke category) pattern is frequent dataset-wide; a node is
     hub or spoke of at most one hub (larger hubs with more spokes first)."""
