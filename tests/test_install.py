@@ -1,7 +1,5 @@
-"""The package as a user meets it: the README's commands verbatim, and a wheel installed without the source tree."""
+"""The package installed as a user installs it: a wheel without the source tree, the conda post-deploy script."""
 import os
-import re
-import shlex
 import shutil
 import subprocess
 import sys
@@ -14,15 +12,6 @@ from conftest import ROOT
 
 pytestmark = pytest.mark.slow
 BIN = Path(sys.executable).parent
-CLUSTER_ONLY = ("--workflow-profile profiles/slurm",)  # tests/slurm/run.sh runs that one on a real Slurm
-
-
-def readme_commands() -> list[str]:
-    """`make pipeline` and every `.venv/bin/...` line of the README's bash blocks, in order, comments stripped
-    (`make test` is this suite)."""
-    text = (ROOT / "README.md").read_text()
-    lines = [line for block in re.findall(r"```bash\n(.*?)```", text, re.S) for line in block.splitlines()]
-    return [line.split(" #")[0].strip() for line in lines if line.startswith((".venv/bin/", "make pipeline"))]
 
 
 def _env_without_venv() -> dict:
@@ -41,32 +30,6 @@ def copy_tracked(dest: Path) -> Path:
         elif src.exists():
             shutil.copy2(src, dest / rel)
     return dest
-
-
-@pytest.fixture(scope="module")
-def clone(tmp_path_factory) -> Path:
-    """A fresh copy of the repository, its venv linked, config/config.yaml made tiny."""
-    dest = copy_tracked(tmp_path_factory.mktemp("clone"))
-    (dest / ".venv").symlink_to(BIN.parent)
-    shutil.copy(ROOT / "config" / "tiny.yaml", dest / "config" / "config.yaml")
-    return dest
-
-
-def test_readme_commands_work_as_written(clone):
-    commands = readme_commands()
-    assert len(commands) >= 8
-    ran = 0
-    for cmd in commands:
-        if any(c in cmd for c in CLUSTER_ONLY):
-            continue
-        out = subprocess.run(shlex.split(cmd), cwd=clone, capture_output=True, text=True, env=_env_without_venv(),
-                             timeout=600)
-        assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}"
-        ran += 1
-        if " -d " in cmd:  # a run in a work folder of its own: it produced the graphs there
-            work = clone / cmd.split(" -d ")[1].split()[0]
-            assert (work / "results/graphs/ingested/edges.parquet").exists(), cmd
-    assert ran == len(commands) - 1
 
 
 def test_wheel_installs_and_runs_without_the_source_tree(tmp_path):
@@ -100,3 +63,19 @@ def test_wheel_installs_and_runs_without_the_source_tree(tmp_path):
     bad = subprocess.run([str(py), "-m", "pipeline", "ingest", "--shard", "0", "--config-json", '{"shards": 0}', *outs],
                          cwd=work, capture_output=True, text=True, timeout=300)
     assert bad.returncode == 2 and "invalid config at key 'shards'" in bad.stderr  # the schema came with the wheel
+
+
+def test_conda_post_deploy_script_installs_the_package(tmp_path):
+    # `--sdm conda` cannot run here (no conda, conda-forge unreachable); what the environment adds to its
+    # dependencies, the post-deploy script, runs here in a fresh venv with the variable the workflow sets
+    source = copy_tracked(tmp_path / "source")
+    venv = tmp_path / "env"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=300)
+    env = {**_env_without_venv(), "PATH": f"{venv / 'bin'}{os.pathsep}{_env_without_venv()['PATH']}",
+           "PLANIT_SOURCE": str(source)}
+    for script in ("environment.post-deploy.sh", "environment-gpu.post-deploy.sh"):
+        out = subprocess.run(["bash", str(ROOT / script)], env=env, capture_output=True, text=True, timeout=600)
+        assert out.returncode == 0, out.stderr[-2000:]
+    show = subprocess.run([str(venv / "bin/python"), "-m", "pip", "show", "-f", "planit-pipeline"], capture_output=True,
+                          text=True, check=True, timeout=120).stdout
+    assert "pipeline/schema.yaml" in show and "Version: 0.1.0" in show

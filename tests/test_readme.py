@@ -1,0 +1,50 @@
+"""The README's commands, verbatim, as a newcomer runs them (no activated venv), on the tiny config."""
+import re
+import shlex
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+from test_install import BIN, _env_without_venv, copy_tracked
+
+pytestmark = pytest.mark.slow
+CLUSTER_ONLY = ("--workflow-profile profiles/slurm",)  # tests/slurm/run.sh runs that one on a real Slurm
+
+
+def readme_commands() -> list[str]:
+    """`make pipeline` and every `.venv/bin/...` line of the README's bash blocks, in order, comments stripped
+    (`make test` is this suite)."""
+    text = (ROOT / "README.md").read_text()
+    lines = [line for block in re.findall(r"```bash\n(.*?)```", text, re.S) for line in block.splitlines()]
+    return [line.split(" #")[0].strip() for line in lines if line.startswith((".venv/bin/", "make pipeline"))]
+
+
+@pytest.fixture(scope="module")
+def clone(tmp_path_factory) -> Path:
+    """A fresh copy of the repository, its venv linked, config/config.yaml made tiny."""
+    dest = copy_tracked(tmp_path_factory.mktemp("clone"))
+    (dest / ".venv").symlink_to(BIN.parent)
+    shutil.copy(ROOT / "config" / "tiny.yaml", dest / "config" / "config.yaml")
+    return dest
+
+
+def test_readme_commands_work_as_written(clone):
+    commands = readme_commands()
+    assert len(commands) >= 8
+    ran = 0
+    for cmd in commands:
+        if any(c in cmd for c in CLUSTER_ONLY):
+            continue
+        out = subprocess.run(shlex.split(cmd), cwd=clone, capture_output=True, text=True, env=_env_without_venv(),
+                             timeout=600)
+        assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}"
+        ran += 1
+        if " -d " in cmd:  # a run in a work folder of its own: it produced the graphs there
+            work = clone / cmd.split(" -d ")[1].split()[0]
+            assert (work / "results/graphs/ingested/edges.parquet").exists(), cmd
+    assert ran == len(commands) - 1
+
+
