@@ -33,10 +33,10 @@ def corpus(workdir: Path, cfg: dict) -> dict[str, Path]:
 def run(workdir: Path, rooms_wanted: int, python_rooms: int) -> dict:
     cfg = default_config()
     p = corpus(workdir, cfg)
-    rooms, arch, objs, models = load_shard(p["kept"], p["architecture"], p["objects"], p["models"])
+    rooms, arch, objs, models, _ = load_shard(p["kept"], p["architecture"], p["objects"], p["models"])
     inputs = list(room_inputs(rooms, arch, objs))[:rooms_wanted]
     sym = lambda c, m: ("none", "default")  # noqa: E731  symmetry does not change the ray work
-    ex = cfg["extract"]
+    ex = {**cfg["extract"], "floor_contact": cfg["floor_contact"]}
     result = {"rooms": len(inputs), "objects": int(sum(len(r.object_ids) for r in inputs)),
               "machine": f"{platform.processor() or platform.machine()}, 1 core (single process)"}
     embree = intersector_class("embree")

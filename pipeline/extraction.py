@@ -26,7 +26,6 @@ MESH, PLAN = 0, 1  # scene layers
 BOX_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
 POSE_COLUMNS = ["px", "py", "pz", "yaw", "sx", "sy", "sz"]
 PIECE_INSET = 1e-3  # m, rays start this far in from each piece's ends
-FLOOR_EPS = 1e-3  # m, an object whose bottom is this close to the floor (z = 0) stands on it
 
 
 @dataclass
@@ -54,6 +53,7 @@ class RoomGraph:
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (node id, reason)
     rays: int = 0
     support_cycles: int = 0
+    hanging: int = 0  # objects with nothing below and a bottom high above the floor
 
 
 @dataclass
@@ -103,11 +103,13 @@ def wall_footprints(w: Walls) -> np.ndarray:
     return np.stack([w.a, w.b, w.b + back, w.a + back], 1)[:, ::-1]
 
 
-def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) -> RoomGraph:
+def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, box_models=None) -> RoomGraph:
     """Raw relation graph of one room.
 
     ``mesh_of(model_id) -> (vertices, faces) | None`` in model space; ``symmetry_of(category, model_id) ->
-    (symmetry, origin)``; ``cfg`` is the ``extract`` config section; ``intersector`` a trimesh ray class.
+    (symmetry, origin)``; ``cfg`` is the ``extract`` config section plus the shared ``floor_contact``;
+    ``intersector`` a trimesh ray class; ``box_models`` the ids of models that are only a box (the box-contact
+    rules apply to those alone; None: every model).
     """
     g = RoomGraph()
     walls = merge_walls(room.wall_segments, room.wall_ids, room.wall_thickness, room.height)
@@ -125,12 +127,19 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) 
     scene.owner[-len(plan[1]):] = np.repeat(np.arange(n + n_walls), per_prism)  # one owner per prism
 
     # support first (the sweep's groups depend on tiers), then the visibility sweep of every anchor side
-    parent, area, rays, cycles = support_parents(scene, b, cfg["support"])
+    boxy = np.array([box_models is None or m in box_models for m in models], bool)
+    parent, area, rays, cycles = support_parents(scene, b, cfg["support"], cfg["floor_contact"], boxy)
     g.rays += rays
     g.support_cycles = cycles
     tier = relations.tiers(parent)
+    hanging = relations.hanging(b, parent, cfg["floor_contact"], cfg["support"]["hanging_min_height"])
+    tier[hanging] = -1
+    g.hanging = int(hanging.sum())
     sym = [symmetry_of(c, m) for c, m in zip(cats, models)]
-    for k in range(n):
+    drop = hanging if cfg["support"]["hanging"] == "drop" else np.zeros(n, bool)
+    for k in np.flatnonzero(drop):
+        g.skipped.append((ids[k], "hanging: nothing below it and its bottom high above the floor"))
+    for k in np.flatnonzero(~drop):
         g.nodes.append({"room_id": room.room_id, "node_id": ids[k], "kind": "object", "category": cats[k],
                         "model_id": models[k], "symmetry": sym[k][0], "symmetry_origin": sym[k][1], "tier": int(tier[k]),
                         "parent_id": ids[parent[k]] if parent[k] >= 0 else None,
@@ -139,34 +148,44 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector) 
             g.edges.append(_edge(room.room_id, ids[parent[k]], ids[k], "support", support_area=float(area[k])))
     _wall_nodes(g, room.room_id, walls)
     radial = np.array([s[0] == "radial" for s in sym], bool)
-    group = np.concatenate([np.where(tier <= 1, 0, parent + 1), np.zeros(n_walls, int)])  # who sees whom
+    # who sees whom: the floor plan (group 0), the objects on one parent (parent + 1); hanging objects none
+    group = np.where(tier == 1, 0, parent + 1)
+    group[hanging] = n + 1 + np.flatnonzero(hanging)
+    group = np.concatenate([group, np.zeros(n_walls, int)])
     g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
     _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
     return g
 
 
-def support_parents(scene: RoomScene, b: np.ndarray, sc: dict) -> tuple[np.ndarray, np.ndarray, int, int]:
+def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: float,
+                    boxy: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, int]:
     """Support parent of every object (-1: the floor) and its supporting area.
 
-    ``b`` (n, 7) boxes, ``sc`` the ``extract.support`` config. Raised objects cast a grid of rays down; each ray
-    takes the nearest mesh of another object within reach; the parent is the object under the largest area.
-    Returns ``parent (n,)``, ``area (n,)`` m^2, the number of rays and of support cycles broken.
+    ``b`` (n, 7) boxes, ``sc`` the ``extract.support`` config, ``floor_contact`` (m) how high a bottom may be and
+    still stand on the floor, ``boxy (n,)`` which objects' models are only boxes. Objects raised above
+    ``floor_contact`` cast a grid of rays down; each ray takes the nearest upward-facing surface of another
+    object within reach (a downward-facing one only when the ray did not start inside that object); the parent is the object under the largest area. The box-contact rules join box-only
+    objects alone. Returns ``parent (n,)``, ``area (n,)`` m^2, the number of rays and of support cycles broken.
     """
     n = len(b)
-    raised = np.flatnonzero(b[:, 2] - b[:, 5] > FLOOR_EPS)  # nothing lies under the floor: only raised objects cast
+    raised = np.flatnonzero(b[:, 2] - b[:, 5] > floor_contact)  # only raised objects cast
     s_orig, s_dir, s_obj, cell = relations.support_rays(b[raised], sc["grid"], sc["start_offset"])
     s_obj = raised[s_obj]
     cell = np.zeros(n) if not len(raised) else np.bincount(raised, weights=cell, minlength=n)
     reach = sc["start_offset"] + sc["max_distance"]
+    # only upward-facing surfaces hold things; a downward-facing face counts only where the ray did not start
+    # inside that object (then it entered through a top face level with the caster's bottom, which the step past
+    # the caster's own coincident bottom face skips)
     first_owner, first_dist = scene.first_accepted(
-        s_orig, s_dir, lambda r, own, lay: (lay == MESH) & (own != s_obj[r]), max_dist=reach)
+        s_orig, s_dir, lambda r, own, lay, face: (lay == MESH) & (own != s_obj[r])
+        & (scene.up[face] | ~relations.inside_boxes(s_orig[r], b[own])), max_dist=reach)
     footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
     if sc["inside_box_contact"]:
-        _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, sc["start_offset"])
+        _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, sc["start_offset"], boxy)
     parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
-    if sc["inside_box_contact"] and len(raised):  # raised, nothing below: held from around (hung in a slab)?
-        loose = raised[parent[raised] < 0]
-        held = relations.holding_box(b, loose)
+    if sc["inside_box_contact"] and len(raised):  # raised box, nothing below: held from around (hung in a slab)?
+        loose = raised[(parent[raised] < 0) & boxy[raised]]
+        held = relations.holding_box(b, loose, boxy)
         parent[loose] = np.where(held >= 0, held, parent[loose])
         area[loose] = np.where(held >= 0, footprint[loose], area[loose])
     parent, cycles = relations.break_support_cycles(parent, footprint)
@@ -174,16 +193,16 @@ def support_parents(scene: RoomScene, b: np.ndarray, sc: dict) -> tuple[np.ndarr
     return parent, area, len(s_orig), len(cycles)
 
 
-def _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, start_offset) -> None:
+def _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, start_offset, boxy) -> None:
     """Box-only sources: a grid point whose ray finds nothing within reach but that lies in another object's box
     rests in or on the smallest such box (boxes reach above their support surface: cushions on beds, things in
     fridges); a face level with the object's own bottom hides behind the bottom itself, so the point just below
     the bottom is tested too. Updates ``first_owner`` / ``first_dist`` in place."""
     volume = np.prod(2 * b[:, 3:6], axis=1)
-    miss = first_dist > reach
-    owner_in, _ = relations.containing_box(s_orig[miss], b, s_obj[miss], volume)
+    miss = (first_dist > reach) & boxy[s_obj]
+    owner_in, _ = relations.containing_box(s_orig[miss], b, s_obj[miss], volume, boxy)
     below = s_orig[miss] - [0.0, 0.0, start_offset + 1e-3]
-    owner_in = np.where(owner_in >= 0, owner_in, relations.containing_box(below, b, s_obj[miss], volume)[0])
+    owner_in = np.where(owner_in >= 0, owner_in, relations.containing_box(below, b, s_obj[miss], volume, boxy)[0])
     first_owner[miss] = np.where(owner_in >= 0, owner_in, first_owner[miss])
     first_dist[miss] = np.where(owner_in >= 0, 0.0, first_dist[miss])
 
@@ -328,10 +347,11 @@ def _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n) -> tupl
     dirs = np.column_stack([sides["normal"][ray_side], np.zeros(len(pos))])
     anchor = sides["owner"][ray_side]
     # supported anchors only see siblings on the same parent: their rays stop beyond the parent's footprint
-    reach_of_group = np.concatenate([[np.inf], 2 * diag[:n]])  # group g > 0 lives on object g - 1
+    # group g in 1..n lives on object g - 1; hanging objects (groups above n) see nothing
+    reach_of_group = np.concatenate([[np.inf], 2 * diag[:n], np.zeros(n)])
     reach = sides["inset"][ray_side] + reach_of_group[group[anchor]]
     hit_owner, hit_dist = scene.first_accepted(
-        origins, dirs, lambda r, own, lay: (lay == PLAN) & (own != anchor[r]) & (group[own] == group[anchor[r]]),
+        origins, dirs, lambda r, own, lay, face: (lay == PLAN) & (own != anchor[r]) & (group[own] == group[anchor[r]]),
         max_dist=reach)
     pr = hit_dist.reshape(-1, 2)  # per piece: the nearer of its two rays
     pick = np.argmin(pr, axis=1)

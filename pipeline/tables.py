@@ -160,7 +160,7 @@ SCHEMAS: dict[str, pa.Schema] = {
         _f("model_id", _STR),
         _f("symmetry", _CAT, doc="functional symmetry type"),
         _f("symmetry_origin", _CAT, doc="table | detected | architecture"),
-        _f("tier", _I32, doc="0 architecture, 1 on the floor, 2 supported by a tier-1 object, ..."),
+        _f("tier", _I32, doc="0 architecture, 1 on the floor, 2 supported by a tier-1 object, ...; -1 hanging"),
         _f("parent_id", _STR, doc="support parent (null: floor)"),
         *_box_fields(),
         _f("length", _F64, "m", "walls, doors, windows: segment length"),

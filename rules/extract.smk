@@ -30,7 +30,8 @@ rule extract_graphs:
         edges=RAW.replace("{table}", "edges"),
         summary=RAW_SUMMARY,
     params:
-        config=keys("extract.backend", "extract.support", "extract.spatial", "extract.distance", "extract.architecture"),
+        config=keys("extract.backend", "extract.support", "extract.spatial", "extract.distance", "extract.architecture",
+                    "floor_contact"),
     log:
         "logs/extract_graphs/{corpus}-{shard}.log",
     benchmark:

@@ -56,7 +56,7 @@ rule filter_rooms:
         rooms=FILTER_ROOMS,
         report=FILTER_SHARD_REPORT,
     params:
-        config=keys("filter"),
+        config=keys("filter", "floor_contact"),
     log:
         "logs/filter_rooms/{shard}.log",
     benchmark:

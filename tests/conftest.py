@@ -83,11 +83,13 @@ class Room:
         arch = pd.concat([walls if walls is not None else self.walls(), self.openings_df()], ignore_index=True)
         return next(room_inputs(rooms, arch, self.objects_df()))
 
-    def extract(self, backend="embree", symmetry=None, cfg=None, walls=None):
-        cfg = cfg or default_config()["extract"]
+    def extract(self, backend="embree", symmetry=None, cfg=None, walls=None, box_models=None):
+        """The room's raw graph; ``box_models`` as extract_room's (None: every model is box-only)."""
+        defaults = default_config()
+        cfg = {"floor_contact": defaults["floor_contact"], **(cfg or defaults["extract"])}
         symmetry = symmetry or {}
         return extract_room(self.room_input(walls), self.models.get, lambda c, m: (symmetry.get(c, "none"), "table"),
-                            cfg, intersector_class(backend))
+                            cfg, intersector_class(backend), box_models)
 
 
 def default_config() -> dict:

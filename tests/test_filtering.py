@@ -9,7 +9,8 @@ from pipeline.filtering import category_room_counts, filter_rooms
 from pipeline.shards import shard_of
 from conftest import Room
 
-CFG = config.validate({"filter": {"min_category_rooms": 1}})["filter"]
+_C = config.validate({"filter": {"min_category_rooms": 1}})
+CFG = {**_C["filter"], "floor_contact": _C["floor_contact"]}  # what the filter stage passes
 
 
 def tables_of(*rooms):
@@ -109,3 +110,11 @@ def test_filters_catch_every_planted_defect_and_keep_clean_rooms(corpus):
         assert rule in rep.loc[room_id, "rules"], (room_id, rule, rep.loc[room_id, "detail"])
     clean = rep.drop(index=defects.index)
     assert (clean["status"] == "kept").mean() >= 0.97
+
+
+def test_floor_objects_use_the_shared_floor_contact_tolerance():
+    r = bedroom()  # a bed and four chairs: five floor objects, the minimum for a bedroom
+    r.objects[1]["cz"] += 0.03  # 3 cm up: still on the floor (real meshes float 1-35 mm)
+    assert verdict(r)["b"][0] == "kept"
+    r.objects[1]["cz"] += 0.03  # 6 cm up: no longer
+    assert verdict(r)["b"][:2] == ("rejected", "too_few_objects")

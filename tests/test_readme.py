@@ -10,7 +10,7 @@ import pytest
 from conftest import ROOT
 from test_install import BIN, _env_without_venv, copy_tracked
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("readme")]
 CLUSTER_ONLY = ("--workflow-profile profiles/slurm",)  # tests/slurm/run.sh runs that one on a real Slurm
 
 

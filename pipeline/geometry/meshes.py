@@ -2,38 +2,44 @@
 from __future__ import annotations
 
 import numpy as np
-import trimesh
 
 Mesh = tuple[np.ndarray, np.ndarray]
 
 
-def _pair(m: trimesh.Trimesh) -> Mesh:
+def _creation():
+    """trimesh.creation, imported on first use (trimesh takes ~0.7 s to import; most stages never need it)."""
+    import trimesh.creation
+
+    return trimesh.creation
+
+
+def _pair(m) -> Mesh:
     return np.asarray(m.vertices, dtype=float), np.asarray(m.faces, dtype=np.int64)
 
 
 def box(extents, centre=(0.0, 0.0, 0.0)) -> Mesh:
     """Axis-aligned box of full ``extents`` (x, y, z) centred at ``centre``."""
-    m = trimesh.creation.box(extents=np.asarray(extents, dtype=float))
+    m = _creation().box(extents=np.asarray(extents, dtype=float))
     m.apply_translation(centre)
     return _pair(m)
 
 
 def cylinder(radius: float, height: float, centre=(0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
     """Vertical cylinder."""
-    m = trimesh.creation.cylinder(radius=radius, height=height, sections=sections)
+    m = _creation().cylinder(radius=radius, height=height, sections=sections)
     m.apply_translation(centre)
     return _pair(m)
 
 
 def cone(radius: float, height: float, base=(0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
     """Vertical cone standing on ``base``."""
-    m = trimesh.creation.cone(radius=radius, height=height, sections=sections)
+    m = _creation().cone(radius=radius, height=height, sections=sections)
     m.apply_translation(base)
     return _pair(m)
 
 
 def sphere(radius: float, centre=(0.0, 0.0, 0.0), subdivisions: int = 1) -> Mesh:
-    m = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    m = _creation().icosphere(subdivisions=subdivisions, radius=radius)
     m.apply_translation(centre)
     return _pair(m)
 

@@ -7,8 +7,9 @@ from __future__ import annotations
 import logging
 import warnings
 
+from types import SimpleNamespace
+
 import numpy as np
-import trimesh
 
 from ..errors import PlanitError
 from .meshes import Mesh, combine
@@ -23,9 +24,9 @@ class BackendError(PlanitError):
 def intersector_class(backend: str):
     """The trimesh intersector class for ``backend`` ('embree' or 'python'); fail clearly if Embree is missing."""
     if backend == "embree":
-        from trimesh.ray import has_embree
+        import importlib.util
 
-        if not has_embree:
+        if importlib.util.find_spec("embreex") is None:
             raise BackendError("extract.backend is 'embree' but trimesh cannot load embreex (pip install "
                                "embreex==4.4.0.post1; there is no wheel for Linux aarch64). Set extract.backend: "
                                "python to use trimesh's pure-Python backend instead (about 1000x slower).")
@@ -48,7 +49,7 @@ class EmbreeIntersector:
 
     _device = None
 
-    def __init__(self, mesh: trimesh.Trimesh) -> None:
+    def __init__(self, mesh) -> None:
         from embreex import rtcore, rtcore_scene
         from embreex.mesh_construction import TriangleMesh
 
@@ -82,18 +83,24 @@ class RoomScene:
         counts = [len(f) for _, f in parts]
         self.owner = np.repeat(np.asarray(owners, dtype=np.int64), counts)
         self.layer = np.repeat(np.asarray(layers, dtype=np.int8), counts)
-        mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False, validate=False)
+        if intersector is EmbreeIntersector:  # needs only the arrays: no trimesh import on the fast path
+            mesh = SimpleNamespace(vertices=vertices, faces=faces)
+        else:
+            import trimesh
+
+            mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False, validate=False)
         v0 = vertices[faces[:, 0]]
         self._normal = np.cross(vertices[faces[:, 1]] - v0, vertices[faces[:, 2]] - v0)
         self._offset = np.einsum("ij,ij->i", self._normal, v0)  # face planes: normal . x = offset
         self._step = max(1e-8, float(np.ptp(vertices, axis=0).max()) * 1e-6)
+        self.up = self._normal[:, 2] > 0  # faces whose outward normal points up (surfaces that can hold things)
         self._rays = intersector(mesh)
 
     def first_accepted(self, origins: np.ndarray, directions: np.ndarray, accept, max_dist=np.inf,
                        max_steps: int = 256) -> tuple[np.ndarray, np.ndarray]:
         """Nearest hit per ray that ``accept`` takes, stepping through the hits it refuses.
 
-        ``accept(ray (k,), owner (k,), layer (k,)) -> (k,) bool``. A ray retires at its first accepted hit,
+        ``accept(ray (k,), owner (k,), layer (k,), face (k,)) -> (k,) bool``. A ray retires at its first accepted hit,
         when it leaves the scene, or beyond ``max_dist`` (scalar or per ray). Directions must be unit vectors.
         Returns ``owner (n,)`` (-1: none) and ``distance (n,)`` (inf: none).
         """
@@ -122,7 +129,7 @@ class RoomScene:
             dist = travelled[live] + step
             inside = dist <= limit[live]
             live, tri, d, step, dist = live[inside], tri[inside], d[inside], step[inside], dist[inside]
-            ok = accept(live, self.owner[tri], self.layer[tri])
+            ok = accept(live, self.owner[tri], self.layer[tri], tri)
             best_owner[live[ok]] = self.owner[tri[ok]]
             best_dist[live[ok]] = dist[ok]
             live, tri, d, step = live[~ok], tri[~ok], d[~ok], step[~ok]

@@ -65,7 +65,8 @@ def choose_parents(obj: np.ndarray, hit_owner: np.ndarray, hit_dist: np.ndarray,
     return parent, area
 
 
-def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volume: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volume: np.ndarray,
+                   eligible: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """For each point, the box (other than ``own``) that contains it with its top nearest above the point
     (the surface it most likely rests on; ties to the smaller box); -1 where none.
 
@@ -81,13 +82,24 @@ def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volum
     ly = -rel[..., 0] * s + rel[..., 1] * c
     inside = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (np.abs(points[:, None, 2] - b[:, 2]) <= b[:, 5])
     inside[np.arange(len(points)), own] = False
+    if eligible is not None:  # only these boxes may hold (box-only models: a meshed model's box is no surface)
+        inside &= np.asarray(eligible, bool)[None, :]
     top = b[:, 2] + b[:, 5]
     score = np.where(inside, (top[None, :] - points[:, None, 2]) + 1e-6 * volume[None, :] / max(volume.max(), 1e-12), np.inf)
     best = np.argmin(score, axis=1)
     return np.where(np.isfinite(score[np.arange(len(points)), best]), best, -1), inside
 
 
-def holding_box(boxes: np.ndarray, candidates: np.ndarray) -> np.ndarray:
+def inside_boxes(points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """``(k,)`` bool: whether each point ``(k, 3)`` lies inside its own box ``(k, 7)`` (pairwise, not all pairs)."""
+    p, b = np.asarray(points, float).reshape(-1, 3), np.asarray(boxes, float).reshape(-1, 7)
+    rel = p[:, :2] - b[:, :2]
+    c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
+    lx, ly = rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c
+    return (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (np.abs(p[:, 2] - b[:, 2]) <= b[:, 5])
+
+
+def holding_box(boxes: np.ndarray, candidates: np.ndarray, eligible: np.ndarray | None = None) -> np.ndarray:
     """For each candidate box, the box that holds it from around: its footprint contains the candidate's
     centre and its vertical span starts above the candidate's bottom and overlaps it (a sink hung in a
     counter slab, a ladle through a holder). The lowest such box wins; -1 where none."""
@@ -101,9 +113,21 @@ def holding_box(boxes: np.ndarray, candidates: np.ndarray) -> np.ndarray:
         k_bottom, k_top = b[k, 2] - b[k, 5], b[k, 2] + b[k, 5]
         ok = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (bottom > k_bottom) & (bottom < k_top)
         ok[k] = False
+        if eligible is not None:
+            ok &= np.asarray(eligible, bool)
         if ok.any():
             out[i] = int(np.flatnonzero(ok)[np.argmin(bottom[ok])])
     return out
+
+
+def hanging(boxes: np.ndarray, parent: np.ndarray, floor_contact: float, min_height: float) -> np.ndarray:
+    """``(n,)`` bool: objects that hang (pendant lamps, wall-mounted things): no support parent, nothing resting
+    on them, and a bottom more than ``min_height`` above the floor (and above ``floor_contact``)."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    bottom = b[:, 2] - b[:, 5]
+    is_parent = np.zeros(len(b), bool)
+    is_parent[parent[parent >= 0]] = True
+    return (parent < 0) & ~is_parent & (bottom > max(min_height, floor_contact))
 
 
 def break_support_cycles(parent: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:

@@ -24,23 +24,26 @@ def load_shard(rooms: Path, architecture: Path, objects: Path, models: Path):
     arch = tables.read(architecture, "architecture", filters=[("room_id", "in", ids)]).to_pandas()
     objs = tables.read(objects, "objects", filters=[("room_id", "in", ids)]).to_pandas()
     used = sorted(set(objs["model_id"].dropna()))
-    rows = tables.read(models, "models", filters=[("model_id", "in", used)], columns=["model_id", "vertices", "faces"])
-    return room_df, arch, objs, {m["model_id"]: tables.model_mesh(m) for m in rows.to_pylist()}
+    rows = tables.read(models, "models", filters=[("model_id", "in", used)],
+                       columns=["model_id", "vertices", "faces", "mesh_kind"]).to_pylist()
+    box_models = {m["model_id"] for m in rows if m["mesh_kind"] == "box_fallback"}
+    return room_df, arch, objs, {m["model_id"]: tables.model_mesh(m) for m in rows}, box_models
 
 
 def run(config: dict, shard: int, rooms: Path, architecture: Path, objects: Path, models: Path, symmetry: Path,
         out_nodes: Path, out_edges: Path, out_summary: Path) -> dict:
-    cfg = config["extract"]
+    cfg = {**config["extract"], "floor_contact": config["floor_contact"]}
     intersector = intersector_class(cfg["backend"])
-    room_df, arch, objs, meshes = load_shard(rooms, architecture, objects, models)
+    room_df, arch, objs, meshes, box_models = load_shard(rooms, architecture, objects, models)
     sym = tables.read(symmetry, "symmetry", columns=["model_id", "symmetry", "origin"]).to_pylist()
     by_model = {r["model_id"]: (r["symmetry"], r["origin"]) for r in sym}
     nodes, edges, skipped = [], [], []
-    rays = cycles = 0
+    rays = cycles = hanging = 0
     start = time.perf_counter()
     for room in progress(room_inputs(room_df, arch, objs), total=len(room_df), desc=f"extract shard {shard}"):
         try:
-            g = extract_room(room, meshes.get, lambda c, m: by_model.get(m, ("none", "default")), cfg, intersector)
+            g = extract_room(room, meshes.get, lambda c, m: by_model.get(m, ("none", "default")), cfg, intersector,
+                             box_models)
         except ValueError as exc:
             log.warning("room %s skipped: %s", room.room_id, exc)
             skipped.append({"room_id": room.room_id, "node_id": None, "reason": str(exc)})
@@ -50,6 +53,7 @@ def run(config: dict, shard: int, rooms: Path, architecture: Path, objects: Path
             skipped.append({"room_id": room.room_id, "node_id": node_id, "reason": reason})
         rays += g.rays
         cycles += g.support_cycles
+        hanging += g.hanging
         for row in g.nodes + g.edges:
             row.update(room_type=room.room_type, shard=shard)
         nodes += g.nodes
@@ -59,6 +63,6 @@ def run(config: dict, shard: int, rooms: Path, architecture: Path, objects: Path
     tables.write(out_nodes, "nodes", tables.from_rows("nodes", nodes), extra)
     tables.write(out_edges, "edges", tables.from_rows("edges", edges), extra)
     summary = {"shard": shard, "rooms": len(room_df), "nodes": len(nodes), "edges": len(edges), "rays": rays,
-               "support_cycles": cycles, "seconds": round(seconds, 3), "skipped": skipped, "backend": cfg["backend"]}
+               "support_cycles": cycles, "hanging": hanging, "seconds": round(seconds, 3), "skipped": skipped, "backend": cfg["backend"]}
     tables.write_json(out_summary, summary)
     return {k: v for k, v in summary.items() if k != "skipped"} | {"skipped": len(skipped)}

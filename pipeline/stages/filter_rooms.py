@@ -18,7 +18,7 @@ def run(config: dict, rooms: Path, architecture: Path, objects: Path, counts: Pa
     """Write the shard's kept rooms (``rooms`` schema) and its filter report."""
     room_df = tables.read(rooms, "rooms").to_pandas()
     report = filter_rooms(room_df, tables.read(architecture, "architecture").to_pandas(),
-                          tables.read(objects, "objects").to_pandas(), config["filter"],
+                          tables.read(objects, "objects").to_pandas(), {**config["filter"], "floor_contact": config["floor_contact"]},
                           tables.read(counts, "category_counts").to_pandas())
     kept = room_df[room_df["room_id"].isin(report.loc[report["status"] == "kept", "room_id"])]
     extra = {"config_hash": config_hash(config["filter"])}
