@@ -194,17 +194,26 @@ def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: fl
 
 
 def _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, start_offset, boxy) -> None:
-    """Box-only sources: a grid point whose ray finds nothing within reach but that lies in another object's box
-    rests in or on the smallest such box (boxes reach above their support surface: cushions on beds, things in
-    fridges); a face level with the object's own bottom hides behind the bottom itself, so the point just below
-    the bottom is tested too. Updates ``first_owner`` / ``first_dist`` in place."""
+    """Box-only sources: a grid point whose ray finds nothing within reach but lies in another object's box rests
+    on the box whose top surface is nearest the object's bottom (boxes reach above their support surface:
+    cushions on beds, things in fridges; a chair tucked under a desk rises above the desk top the bowl stands
+    on). The point just below the object's bottom is tested too (a top level with the bottom hides behind the
+    bottom face). Updates ``first_owner`` / ``first_dist`` in place."""
     volume = np.prod(2 * b[:, 3:6], axis=1)
-    miss = (first_dist > reach) & boxy[s_obj]
-    owner_in, _ = relations.containing_box(s_orig[miss], b, s_obj[miss], volume, boxy)
-    below = s_orig[miss] - [0.0, 0.0, start_offset + 1e-3]
-    owner_in = np.where(owner_in >= 0, owner_in, relations.containing_box(below, b, s_obj[miss], volume, boxy)[0])
-    first_owner[miss] = np.where(owner_in >= 0, owner_in, first_owner[miss])
-    first_dist[miss] = np.where(owner_in >= 0, 0.0, first_dist[miss])
+    miss = np.flatnonzero((first_dist > reach) & boxy[s_obj])
+    if not len(miss):
+        return
+    origin, own = s_orig[miss], s_obj[miss]
+    below = origin - [0.0, 0.0, start_offset + 1e-3]
+    inside = relations.containing_box(origin, b, own, volume, boxy)[1] | relations.containing_box(below, b, own, volume, boxy)[1]
+    bottom = origin[:, 2] - start_offset
+    top = b[:, 2] + b[:, 5]
+    score = np.where(inside, np.abs(top[None, :] - bottom[:, None]) + 1e-6 * volume[None, :] / max(volume.max(), 1e-12),
+                     np.inf)
+    best = np.argmin(score, axis=1)
+    found = np.isfinite(score[np.arange(len(miss)), best])
+    first_owner[miss[found]] = best[found]
+    first_dist[miss[found]] = 0.0
 
 
 def _usable_objects(g: RoomGraph, room: RoomInput, mesh_of) -> tuple[list[int], list]:

@@ -40,7 +40,7 @@ def planned_jobs(proc: subprocess.CompletedProcess) -> set[str]:
     return {m.group(1) for m in re.finditer(r"^(\w+)\s+\d+$", block, re.M)} - {"total", "all"}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # once per worker: xdist interleaves modules, which would rebuild a module fixture
 def run_dir(tmp_path_factory):
     work = tmp_path_factory.mktemp("e2e")
     snakemake(work)

@@ -22,7 +22,7 @@ def readme_commands() -> list[str]:
     return [line.split(" #")[0].strip() for line in lines if line.startswith((".venv/bin/", "make pipeline"))]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # once per worker: xdist interleaves modules, which would rebuild a module fixture
 def clone(tmp_path_factory) -> Path:
     """A fresh copy of the repository, its venv linked, config/config.yaml made tiny."""
     dest = copy_tracked(tmp_path_factory.mktemp("clone"))
