@@ -205,7 +205,7 @@ def _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, start_offset
         return
     origin, own = s_orig[miss], s_obj[miss]
     below = origin - [0.0, 0.0, start_offset + 1e-3]
-    inside = relations.containing_box(origin, b, own, volume, boxy)[1] | relations.containing_box(below, b, own, volume, boxy)[1]
+    inside = relations.box_containment(origin, b, own, boxy) | relations.box_containment(below, b, own, boxy)
     bottom = origin[:, 2] - start_offset
     top = b[:, 2] + b[:, 5]
     score = np.where(inside, np.abs(top[None, :] - bottom[:, None]) + 1e-6 * volume[None, :] / max(volume.max(), 1e-12),

@@ -11,13 +11,12 @@ that object, each recorded in the ledger's drop rows with the file, ids and JSON
 """
 from __future__ import annotations
 
+import json
 import logging
 import math
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
-
-import json
 
 import numpy as np
 import shapely

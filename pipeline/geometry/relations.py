@@ -65,38 +65,29 @@ def choose_parents(obj: np.ndarray, hit_owner: np.ndarray, hit_dist: np.ndarray,
     return parent, area
 
 
-def containing_box(points: np.ndarray, boxes: np.ndarray, own: np.ndarray, volume: np.ndarray,
-                   eligible: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """For each point, the box (other than ``own``) that contains it with its top nearest above the point
-    (the surface it most likely rests on; ties to the smaller box); -1 where none.
+def _in_box(points: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Whether points ``(..., 3)`` lie inside oriented boxes ``(..., 7)`` (broadcast against each other)."""
+    rel = points[..., :2] - b[..., :2]
+    c, s = np.cos(b[..., 6]), np.sin(b[..., 6])
+    lx, ly = rel[..., 0] * c + rel[..., 1] * s, -rel[..., 0] * s + rel[..., 1] * c
+    return (np.abs(lx) <= b[..., 3]) & (np.abs(ly) <= b[..., 4]) & (np.abs(points[..., 2] - b[..., 2]) <= b[..., 5])
 
-    ``points (k, 3)``, ``boxes (n, 7)``, ``own (k,)`` box index to ignore per point. Returns the box index and
-    a (k, n) containment mask.
-    """
-    b = np.asarray(boxes, float).reshape(-1, 7)
-    if not len(points) or not len(b):
-        return np.full(len(points), -1, dtype=np.int64), np.zeros((len(points), len(b)), bool)
-    rel = points[:, None, :2] - b[None, :, :2]  # (k, n, 2)
-    c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
-    lx = rel[..., 0] * c + rel[..., 1] * s
-    ly = -rel[..., 0] * s + rel[..., 1] * c
-    inside = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (np.abs(points[:, None, 2] - b[:, 2]) <= b[:, 5])
-    inside[np.arange(len(points)), own] = False
-    if eligible is not None:  # only these boxes may hold (box-only models: a meshed model's box is no surface)
+
+def box_containment(points: np.ndarray, boxes: np.ndarray, own: np.ndarray,
+                    eligible: np.ndarray | None = None) -> np.ndarray:
+    """``(k, n)`` bool: which boxes contain each point, never the point's ``own`` box and, with ``eligible (n,)``,
+    only those boxes (box-only models: a meshed model's box is no surface). ``points (k, 3)``, ``boxes (n, 7)``."""
+    p, b = np.asarray(points, float).reshape(-1, 3), np.asarray(boxes, float).reshape(-1, 7)
+    inside = _in_box(p[:, None, :], b[None, :, :])
+    inside[np.arange(len(p)), own] = False
+    if eligible is not None:
         inside &= np.asarray(eligible, bool)[None, :]
-    top = b[:, 2] + b[:, 5]
-    score = np.where(inside, (top[None, :] - points[:, None, 2]) + 1e-6 * volume[None, :] / max(volume.max(), 1e-12), np.inf)
-    best = np.argmin(score, axis=1)
-    return np.where(np.isfinite(score[np.arange(len(points)), best]), best, -1), inside
+    return inside
 
 
 def inside_boxes(points: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """``(k,)`` bool: whether each point ``(k, 3)`` lies inside its own box ``(k, 7)`` (pairwise, not all pairs)."""
-    p, b = np.asarray(points, float).reshape(-1, 3), np.asarray(boxes, float).reshape(-1, 7)
-    rel = p[:, :2] - b[:, :2]
-    c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
-    lx, ly = rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c
-    return (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (np.abs(p[:, 2] - b[:, 2]) <= b[:, 5])
+    return _in_box(np.asarray(points, float).reshape(-1, 3), np.asarray(boxes, float).reshape(-1, 7))
 
 
 def holding_box(boxes: np.ndarray, candidates: np.ndarray, eligible: np.ndarray | None = None) -> np.ndarray:
@@ -104,14 +95,13 @@ def holding_box(boxes: np.ndarray, candidates: np.ndarray, eligible: np.ndarray 
     centre and its vertical span starts above the candidate's bottom and overlaps it (a sink hung in a
     counter slab, a ladle through a holder). The lowest such box wins; -1 where none."""
     b = np.asarray(boxes, float).reshape(-1, 7)
+    bottom = b[:, 2] - b[:, 5]
+    flat = b.copy()
+    flat[:, 5] = np.inf  # the footprint test alone: the vertical condition follows
     out = np.full(len(candidates), -1, dtype=np.int64)
     for i, k in enumerate(candidates):
-        rel = b[k, :2] - b[:, :2]
-        c, s = np.cos(b[:, 6]), np.sin(b[:, 6])
-        lx, ly = rel[:, 0] * c + rel[:, 1] * s, -rel[:, 0] * s + rel[:, 1] * c
-        bottom = b[:, 2] - b[:, 5]
         k_bottom, k_top = b[k, 2] - b[k, 5], b[k, 2] + b[k, 5]
-        ok = (np.abs(lx) <= b[:, 3]) & (np.abs(ly) <= b[:, 4]) & (bottom > k_bottom) & (bottom < k_top)
+        ok = _in_box(b[k, None, :3], flat) & (bottom > k_bottom) & (bottom < k_top)
         ok[k] = False
         if eligible is not None:
             ok &= np.asarray(eligible, bool)
