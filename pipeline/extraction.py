@@ -26,6 +26,7 @@ MESH, PLAN = 0, 1  # scene layers
 BOX_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
 POSE_COLUMNS = ["px", "py", "pz", "yaw", "sx", "sy", "sz"]
 PIECE_INSET = 1e-3  # m, rays start this far in from each piece's ends
+TOUCH = 1e-6  # m, a footprint this close to an anchor side (or reaching behind it) touches it
 
 
 @dataclass
@@ -289,9 +290,10 @@ def anchor_sides(b: np.ndarray, walls: Walls, sp: dict) -> dict[str, np.ndarray]
     }
 
 
-def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Split every side at the projected corners of the footprints it may see (same group, not itself,
-    not wholly behind its ray origins). Returns ``piece_side (p,)``, ``starts (p,)``, ``ends (p,)``."""
+    not wholly behind its ray origins). Returns ``piece_side (p,)`` (sorted), ``starts (p,)``, ``ends (p,)`` and
+    ``near (S, O)``: footprints that may touch the side (a corner on or behind its line)."""
     owners = sides["owner"]
     o = len(all_fp)
     rel = all_fp[None, :, :, :] - sides["centre"][:, None, None, :]  # (S, O, 4, 2)
@@ -308,7 +310,34 @@ def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarra
     starts, ends = cuts[:, :-1], cuts[:, 1:]
     valid = np.isfinite(ends) & (ends - starts > 1e-6)
     side_idx = np.broadcast_to(np.arange(len(owners))[:, None], starts.shape)
-    return side_idx[valid], starts[valid], ends[valid]
+    return side_idx[valid], starts[valid], ends[valid], live & (d.min(axis=2) <= TOUCH)
+
+
+def touching(sides: dict, all_fp: np.ndarray, near: np.ndarray, piece_side: np.ndarray, starts: np.ndarray,
+             ends: np.ndarray) -> np.ndarray:
+    """Per piece, the footprint that touches or overlaps it (within the piece, less PIECE_INSET at each end as for the
+    rays, it reaches from at most TOUCH in front of the side's line to the line or across it), -1 where none.
+
+    Nothing can stand between a side and a footprint that touches it, so no ray decides these pieces: a ray would
+    leave the anchor through a face coplanar with the target's and Embree may report either (flush neighbours).
+    Where several touch one piece, the deepest wins. ``near (S, O)`` from :func:`sweep`."""
+    owner = np.full(len(piece_side), -1, dtype=np.int64)
+    s_idx, o_idx = np.nonzero(near)
+    counts = np.bincount(piece_side, minlength=len(near))
+    reps = counts[s_idx]
+    if not reps.sum():
+        return owner
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    pair = np.repeat(np.arange(len(s_idx)), reps)
+    piece = np.repeat(first[s_idx] - np.cumsum(reps) + reps, reps) + np.arange(reps.sum())
+    side = piece_side[piece]
+    lo, hi = relations.piece_rays(starts[piece], ends[piece], PIECE_INSET)[0].reshape(-1, 2).T  # as far in as the rays
+    clear, reach = relations.strip_span(all_fp[o_idx[pair]], sides["centre"][side], sides["tangent"][side],
+                                        sides["normal"][side], lo, hi)
+    hit = (clear <= TOUCH) & (reach >= -TOUCH)  # on the side's line or across it, not wholly behind it
+    order = np.argsort(-clear[hit], kind="stable")  # the deepest written last
+    owner[piece[hit][order]] = o_idx[pair[hit]][order]
+    return owner
 
 
 def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg) -> int:
@@ -316,9 +345,11 @@ def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
     n, n_walls = len(b), len(walls.ids)
     sp = cfg["spatial"]
     sides = anchor_sides(b, walls, sp)
-    piece_side, starts, ends = sweep(sides, all_fp, group)
+    piece_side, starts, ends, near = sweep(sides, all_fp, group)
     diag = np.concatenate([diagonal_2d(b[:, 3], b[:, 4]), np.zeros(n_walls)])  # walls: the target's diagonal decides
     p_owner, p_dist, rays = _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n)
+    touch = touching(sides, all_fp, near, piece_side, starts, ends)
+    p_owner = np.where(touch >= 0, touch, p_owner)
     ok = (p_owner >= 0) & (p_owner < n)  # pieces that reach an object (walls only occlude)
     contained = _contained_pairs(all_fp[:n], group[:n], sp["contain_fraction"])
     if not ok.any() and not contained:

@@ -16,13 +16,16 @@ def extraction_counts(nodes: pd.DataFrame, edges: pd.DataFrame, gt: pd.DataFrame
     want = merged["true_parent"].astype(object).where(merged["true_parent"].notna(), None)
     correct = (got == want) | (got.isna() & want.isna())
     supported = want.notna()
-    adjacent = gt[gt["relation"].astype(str) == "adjacent"][["room_id", "anchor_id", "target_id", "direction"]]
+    adjacent = gt[gt["relation"].astype(str) == "adjacent"][["room_id", "anchor_id", "target_id", "direction", "label"]]
     sp = edges[edges["edge_type"].astype(str) == "spatial"][["room_id", "source", "target", "direction", "distance"]]
     pairs = adjacent.merge(sp.rename(columns={"source": "anchor_id", "target": "target_id", "direction": "got_direction"}),
                            on=["room_id", "anchor_id", "target_id"], how="left")
     found = pairs["distance"].astype(str) == "adjacent"
     same_dir = found & (pairs["got_direction"].astype(str) == pairs["direction"].astype(str))
-    return Counter({"rooms": int(nodes["room_id"].nunique()), "objects": len(merged), "correct": int(correct.sum()),
+    case = pairs["label"].astype(object).fillna("unlabelled").astype(str)
+    per_case = {f"{k}:{c}": int(v) for k, col in (("intended", found | True), ("found", found))
+                for c, v in col.groupby(case).sum().items()}
+    return Counter({**per_case, "rooms": int(nodes["room_id"].nunique()), "objects": len(merged), "correct": int(correct.sum()),
                     "supported": int(supported.sum()), "correct_supported": int((correct & supported).sum()),
                     "intended": len(pairs), "found": int(found.sum()), "same_dir": int(same_dir.sum()),
                     "any_edge": int(pairs["distance"].notna().sum())})
@@ -35,7 +38,15 @@ def extraction_scores(c: Counter) -> dict:
             "supported_objects": c["supported"], "support_parent_recall": _ratio(c["correct_supported"], c["supported"]),
             "intended_adjacent": c["intended"], "adjacent_recall": _ratio(c["found"], c["intended"]),
             "adjacent_direction_agreement": _ratio(c["same_dir"], c["found"]),
-            "intended_pairs_with_any_edge": _ratio(c["any_edge"], c["intended"])}
+            "intended_pairs_with_any_edge": _ratio(c["any_edge"], c["intended"]),
+            "adjacent_recall_by_case": _by_case(c)}
+
+
+def _by_case(c: Counter) -> dict:
+    """Adjacent recall per placement case of the ground truth (gap, flush, overlap, turned; unlabelled sources)."""
+    cases = sorted(k.split(":", 1)[1] for k in c if k.startswith("intended:"))
+    return {case: {"intended": c[f"intended:{case}"], "recall": _ratio(c[f"found:{case}"], c[f"intended:{case}"])}
+            for case in cases}
 
 
 def _ratio(a, b) -> float | None:

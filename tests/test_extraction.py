@@ -207,6 +207,24 @@ def test_lamp_flush_with_or_into_the_sofa_front_is_adjacent(overlap):
     assert (e["direction"], e["distance"]) == ("front", "adjacent") and e["gap"] == pytest.approx(-overlap, abs=1e-6)
 
 
+ROW_180 = [(3.586455, 3.655218), (2.593191, 3.654182), (1.600213, 3.656139), (0.607234, 3.653901)]  # a generated room
+
+
+@pytest.mark.parametrize("turned", [False, True])
+def test_flush_row_neighbours_see_each_other_and_not_through_each_other(turned):
+    """Coplanar faces: a ray leaving one wardrobe through its side is also at the neighbour's side, and Embree may
+    report either face, so touching pieces are decided by geometry. A flush row of wardrobes (0.993 x 0.602 m)
+    against the y = 0 wall, or the generated row that lost its middle edges, backs to the y = 3.956 wall."""
+    r = square_room(3.956)
+    for k, (x, y) in enumerate(ROW_180[:3] if turned else [(0.6 + k * 0.992978, 0.30118) for k in range(3)]):
+        r.add(f"w{k}", "wardrobe", (0.992978, 0.60236, 2.0), (x, y), yaw_deg=180.0 if turned else 0.0)
+    g = r.extract()
+    for a, t in (("w0", "w1"), ("w1", "w0"), ("w1", "w2"), ("w2", "w1")):
+        e = edge(g, a, t)
+        assert e["distance"] == "adjacent" and e["gap"] == pytest.approx(0.0, abs=1e-3), (a, t)  # <= 0.3 mm apart
+    assert edge(g, "w0", "w2") is None and edge(g, "w2", "w0") is None  # hidden behind w1
+
+
 @pytest.mark.parametrize("yaw", [0.0, 10.0, 30.0, 45.0, 77.0])
 def test_turned_chair_gap_is_its_nearest_corner(yaw):
     from pipeline.geometry.boxes import footprint_corners

@@ -5,6 +5,12 @@ room can be rebuilt by itself. Arrangements follow what PlanIT's extraction must
 walls between nightstands with lamps on them, rows of wardrobes and kitchen units, dining tables with chairs
 around, desks with chairs and monitors, sofas facing a TV on a stand, rows of plants, plus free clutter.
 A share of rooms carries one deliberate defect for the filters (recorded as a ``defect`` relation).
+
+Placements are as hard as real rooms when ``placement`` shares are given: a share of contacts is exactly
+flush, a share slightly interpenetrating (objects into each other or into the wall, up to ``max_overlap``),
+and a share of chairs and armchairs is turned (desk chairs pulled out and angled, armchairs at 30-45 deg to a
+wall) with the nearest corner at the contact. Every intended adjacency records its case in ``label``
+(gap | flush | overlap | turned) so that extraction is scored per case.
 """
 from __future__ import annotations
 
@@ -109,6 +115,16 @@ def _direction_label(anchor_category: str, local_xy: np.ndarray) -> str:
     return "right" if x > 0 else "left"
 
 
+def _slack(gaps: list[float]) -> float:
+    """The deepest intended interpenetration among a group's contact gaps (m, >= 0)."""
+    return max(0.0, -min(gaps))
+
+
+def _depth_along(m: Model, turn: float) -> float:
+    """Half extent of a footprint turned by ``turn`` (rad) along the direction it faced before turning."""
+    return abs(m.w / 2 * math.sin(turn)) + abs(m.d / 2 * math.cos(turn))
+
+
 @dataclass
 class RoomBuilder:
     room_id: str
@@ -122,9 +138,10 @@ class RoomBuilder:
     objects: list[Obj] = field(default_factory=list)
     gt: list[dict] = field(default_factory=list)
     keepout: list = field(default_factory=list)
+    placement: dict = field(default_factory=dict)  # shares: flush, overlap, turned; max_overlap in m
     index: int = 0
     _groups: int = 0
-    _placed: list = field(default_factory=list)  # footprints of the first-tier objects placed so far
+    _placed: list = field(default_factory=list)  # (object id, footprint) of the first-tier objects placed so far
     _room: shapely.Polygon | None = None
 
     # ------------------------------------------------------------------ architecture
@@ -186,18 +203,24 @@ class RoomBuilder:
         return shapely.Polygon([(c * lx - s * ly + cx, s * lx + c * ly + cy)
                                 for lx, ly in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))])
 
-    def fits(self, placements: list[tuple[Model, float, float, float]]) -> bool:
-        """All footprints inside the room, outside the door swing, clear of every first-tier object."""
+    def fits(self, placements: list[tuple[Model, float, float, float]], slack: float = 0.0,
+             partners: tuple[str, ...] = ()) -> bool:
+        """All footprints inside the room, outside the door swing, clear of every first-tier object. ``slack`` (m):
+        the intended interpenetration among the placements, with the walls and with the placed objects named in
+        ``partners``; footprints are eroded by it for those checks only (other objects are never touched)."""
         if self._room is None:
             self._room = shapely.Polygon(self.outline).buffer(1e-6)
-        placed = list(self._placed)
+        group = []
         for m, cx, cy, yaw in placements:
-            fp = self._footprint(m, cx, cy, yaw)
-            if not self._room.covers(fp):
+            full = self._footprint(m, cx, cy, yaw)
+            fp = full.buffer(-slack - 1e-4, join_style="mitre") if slack > 0 else full
+            if not self._room.covers(fp) or any(_overlap(full, k) for k in self.keepout):
                 return False
-            if any(_overlap(fp, k) for k in self.keepout) or any(_overlap(fp, p) for p in placed):
+            if any(_overlap(fp if oid in partners else full, p) for oid, p in self._placed):
                 return False
-            placed.append(fp)
+            if any(_overlap(fp, q) for q in group):
+                return False
+            group.append(fp)
         return True
 
     def add(self, category: str, m: Model, cx: float, cy: float, yaw: float, z: float = 0.0, parent: str | None = None) -> Obj:
@@ -206,7 +229,7 @@ class RoomBuilder:
         if parent is not None:
             self.relation("support", parent, o.object_id)
         else:
-            self._placed.append(self._footprint(m, cx, cy, yaw))
+            self._placed.append((o.object_id, self._footprint(m, cx, cy, yaw)))
         return o
 
     def relation(self, relation: str, anchor: str | None, target: str | None, direction: str | None = None,
@@ -222,19 +245,20 @@ class RoomBuilder:
         local = boxes.to_local(np.array([target.cx, target.cy]), anchor.cx, anchor.cy, anchor.yaw)
         return _direction_label(anchor.category, local)
 
-    def adjacent(self, a: Obj, b: Obj, both: bool = True) -> None:
-        self.relation("adjacent", a.object_id, b.object_id, self.direction(a, b))
+    def adjacent(self, a: Obj, b: Obj, case: str, both: bool = True) -> None:
+        self.relation("adjacent", a.object_id, b.object_id, self.direction(a, b), label=case)
         if both:
-            self.relation("adjacent", b.object_id, a.object_id, self.direction(b, a))
+            self.relation("adjacent", b.object_id, a.object_id, self.direction(b, a), label=case)
 
     def remaining(self) -> int:
         return MAX_OBJECTS - len(self.objects)
 
     # ------------------------------------------------------------------ placement helpers
     def wall_group(self, pieces: list[tuple[str, Model, float, float, float]], tries: int = 30,
-                   walls: list[Wall] | None = None) -> tuple[Wall, list[Obj]] | None:
+                   walls: list[Wall] | None = None, slack: float = 0.0) -> tuple[Wall, list[Obj]] | None:
         """Place a rigid group along a wall. ``pieces``: (category, model, gx, gy, yaw_g) in the wall frame
-        (x along the wall from the chosen point, y into the room, yaw relative to facing the room)."""
+        (x along the wall from the chosen point, y into the room, yaw relative to facing the room); ``slack``:
+        the group's intended interpenetration (m)."""
         if len(pieces) > self.remaining():
             return None
         xs = [gx + s * h for _, m, gx, _, _ in pieces for s, h in ((-1, m.w / 2), (1, m.w / 2))]
@@ -250,7 +274,7 @@ class RoomBuilder:
             for cat, m, gx, gy, yg in pieces:
                 p = wall.a + wall.dir * (s + gx) + wall.normal * gy
                 placements.append((m, float(p[0]), float(p[1]), wall.yaw_in + yg))
-            if self.fits(placements):
+            if self.fits(placements, slack):
                 return wall, [self.add(cat, m, cx, cy, yaw) for (cat, *_), (m, cx, cy, yaw) in zip(pieces, placements)]
         return None
 
@@ -283,31 +307,47 @@ class RoomBuilder:
         p = np.array([parent.cx, parent.cy]) + boxes.rotation(parent.yaw) @ np.array([fx, fy])
         top = parent.cz + parent.model.h / 2 + float(self.rng.uniform(0.0, 0.002))
         yaw = parent.yaw + float(self.rng.normal(0, 0.05))
+        if not self._room.covers(self._footprint(m, float(p[0]), float(p[1]), yaw)):  # a parent pushed into a wall
+            p = np.array([parent.cx, parent.cy])
         return self.add(category, m, float(p[0]), float(p[1]), yaw, z=top, parent=parent.object_id)
 
-    def wall_adjacent(self, wall: Wall, objs: list[Obj]) -> None:
-        for o in objs:
-            self.relation("adjacent", wall.element_id, o.object_id, "front")
+    def wall_adjacent(self, wall: Wall, objs: list[Obj], cases: list[str]) -> None:
+        for o, case in zip(objs, cases):
+            self.relation("adjacent", wall.element_id, o.object_id, "front", label=case)
 
     def gap(self, hi: float = 0.008) -> float:
         return float(self.rng.uniform(0.0, hi))
 
+    def contact(self, hi: float = 0.008) -> tuple[float, str]:
+        """The gap (m) of one intended contact and its case: flush (0), overlap (< 0) or gap (0 .. ``hi``)."""
+        u = self.rng.random()
+        flush, overlap = self.placement.get("flush", 0.0), self.placement.get("overlap", 0.0)
+        if u < flush:
+            return 0.0, "flush"
+        if u < flush + overlap:
+            return -float(self.rng.uniform(0.005, self.placement["max_overlap"])), "overlap"
+        return self.gap(hi), "gap"
+
+    def turned(self) -> bool:
+        return bool(self.rng.random() < self.placement.get("turned", 0.0))
+
+
     # ------------------------------------------------------------------ functional arrangements
     def bed_with_nightstands(self) -> None:
         bed, ns = self.model("bed"), self.model("nightstand")
-        g1, g2 = self.gap(), self.gap()
-        back = self.gap(0.006)
-        pieces = [("bed", bed, 0.0, back + bed.d / 2, 0.0),
-                  ("nightstand", ns, -(bed.w / 2 + g1 + ns.w / 2), self.gap(0.006) + ns.d / 2, 0.0),
-                  ("nightstand", ns, bed.w / 2 + g2 + ns.w / 2, self.gap(0.006) + ns.d / 2, 0.0)]
-        placed = self.wall_group(pieces)
+        (g1, c1), (g2, c2) = self.contact(), self.contact()
+        backs = [self.contact(0.006) for _ in range(3)]
+        pieces = [("bed", bed, 0.0, backs[0][0] + bed.d / 2, 0.0),
+                  ("nightstand", ns, -(bed.w / 2 + g1 + ns.w / 2), backs[1][0] + ns.d / 2, 0.0),
+                  ("nightstand", ns, bed.w / 2 + g2 + ns.w / 2, backs[2][0] + ns.d / 2, 0.0)]
+        placed = self.wall_group(pieces, slack=_slack([g1, g2] + [g for g, _ in backs]))
         if placed is None:
             return
         wall, (b, n1, n2) = placed
-        self.wall_adjacent(wall, [b, n1, n2])
+        self.wall_adjacent(wall, [b, n1, n2], [c for _, c in backs])
         hub = self.group_id("hub")
-        for n in (n1, n2):
-            self.adjacent(b, n)
+        for n, case in ((n1, c1), (n2, c2)):
+            self.adjacent(b, n, case)
             self.relation("hub", b.object_id, n.object_id, self.direction(b, n), hub)
             if self.rng.random() < 0.85:
                 self.on_top(n, "table_lamp", (float(self.rng.uniform(-0.3, 0.3)), 0.0))
@@ -315,21 +355,23 @@ class RoomBuilder:
     def row(self, categories: list[str], same_model: bool = True, wall: Wall | None = None) -> None:
         """An adjacent chain of similar-size objects along a wall."""
         ms = [self.model(categories[0])] * len(categories) if same_model else [self.model(c) for c in categories]
-        pieces, x = [], 0.0
+        pieces, x, backs, joins = [], 0.0, [], []
         for cat, m in zip(categories, ms):
-            back = self.gap(0.006)
-            pieces.append((cat, m, x + m.w / 2, back + m.d / 2, 0.0))
-            x += m.w + self.gap(0.006)
-        placed = self.wall_group(pieces, walls=[wall] if wall else None)
+            backs.append(self.contact(0.006))
+            joins.append(self.contact(0.006))
+            pieces.append((cat, m, x + m.w / 2, backs[-1][0] + m.d / 2, 0.0))
+            x += m.w + joins[-1][0]
+        gaps = [g for g, _ in backs] + [g for g, _ in joins[:-1]]
+        placed = self.wall_group(pieces, walls=[wall] if wall else None, slack=_slack(gaps))
         if placed is None:
             return None
         wall, objs = placed
-        self.wall_adjacent(wall, objs)
+        self.wall_adjacent(wall, objs, [c for _, c in backs])
         chain = self.group_id("chain")
         for k, o in enumerate(objs):
             self.relation("chain", objs[0].object_id, o.object_id, None, chain, "adjacent")
             if k:
-                self.adjacent(objs[k - 1], o)
+                self.adjacent(objs[k - 1], o, joins[k - 1][1])
         return objs
 
     def plant_row(self, n: int = 3) -> None:
@@ -349,15 +391,20 @@ class RoomBuilder:
 
     def desk_setup(self, chair_cat: str = "office_chair") -> None:
         desk, chair = self.model("desk"), self.model(chair_cat)
-        back = self.gap(0.006)
-        cgap = float(self.rng.uniform(0.1, 0.3))
+        back, case = self.contact(0.006)
+        pulled = self.turned()  # pulled out and angled: the nearest corner touches the desk's front
+        turn = float(self.rng.choice([-1.0, 1.0]) * self.rng.uniform(math.radians(10), math.radians(30))) if pulled else 0.0
+        cgap = self.gap(0.01) if pulled else float(self.rng.uniform(0.1, 0.3))
         pieces = [("desk", desk, 0.0, back + desk.d / 2, 0.0),
-                  (chair_cat, chair, float(self.rng.uniform(-0.1, 0.1)), back + desk.d + cgap + chair.d / 2, math.pi)]
-        placed = self.wall_group(pieces)
+                  (chair_cat, chair, float(self.rng.uniform(-0.1, 0.1)), back + desk.d + cgap + _depth_along(chair, turn),
+                   math.pi + turn)]
+        placed = self.wall_group(pieces, slack=_slack([back]))
         if placed is None:
             return
         wall, (d, c) = placed
-        self.wall_adjacent(wall, [d])
+        self.wall_adjacent(wall, [d], [case])
+        if pulled:
+            self.adjacent(d, c, "turned", both=False)
         self.relation("faces", c.object_id, d.object_id, "front")
         self.on_top(d, "monitor", (float(self.rng.uniform(-0.4, 0.0)), -0.9))
         if self.rng.random() < 0.6:
@@ -393,7 +440,7 @@ class RoomBuilder:
 
     def tv_and_sofa(self) -> None:
         stand, sofa = self.model("tv_stand"), self.model("sofa")
-        back = self.gap(0.006)
+        back, case = self.contact(0.006)
         dist = float(self.rng.uniform(1.8, 2.6))
         pieces = [("tv_stand", stand, 0.0, back + stand.d / 2, 0.0),
                   ("sofa", sofa, 0.0, back + stand.d + dist + sofa.d / 2, math.pi)]
@@ -401,11 +448,11 @@ class RoomBuilder:
         if with_table:
             ct = self.model("coffee_table")
             pieces.append(("coffee_table", ct, 0.0, back + stand.d + dist - float(self.rng.uniform(0.3, 0.45)) - ct.d / 2, 0.0))
-        placed = self.wall_group(pieces)
+        placed = self.wall_group(pieces, slack=_slack([back]))
         if placed is None:
             return
         wall, objs = placed
-        self.wall_adjacent(wall, [objs[0]])
+        self.wall_adjacent(wall, [objs[0]], [case])
         self.relation("faces", objs[1].object_id, objs[0].object_id, "front")
         self.on_top(objs[0], "tv", (0.0, -0.5))
         if self.rng.random() < 0.5:
@@ -414,22 +461,23 @@ class RoomBuilder:
     def side_table_beside(self, anchor: Obj) -> None:
         st = self.model("side_table")
         side = float(self.rng.choice([-1.0, 1.0]))
-        g = self.gap()
+        g, case = self.contact()
         local = np.array([side * (anchor.model.w / 2 + g + st.w / 2), -anchor.model.d / 2 + st.d / 2 + self.gap(0.05)])
         p = np.array([anchor.cx, anchor.cy]) + boxes.rotation(anchor.yaw) @ local
-        if self.remaining() >= 1 and self.fits([(st, float(p[0]), float(p[1]), anchor.yaw)]):
+        if self.remaining() >= 1 and self.fits([(st, float(p[0]), float(p[1]), anchor.yaw)], _slack([g]), (anchor.object_id,)):
             o = self.add("side_table", st, float(p[0]), float(p[1]), anchor.yaw)
-            self.adjacent(anchor, o)
+            self.adjacent(anchor, o, case)
             if self.rng.random() < 0.7:
                 self.on_top(o, "table_lamp")
 
     def against_wall(self, category: str, on_top: str | None = None) -> Obj | None:
         m = self.model(category)
-        placed = self.wall_group([(category, m, 0.0, self.gap(0.006) + m.d / 2, 0.0)])
+        back, case = self.contact(0.006)
+        placed = self.wall_group([(category, m, 0.0, back + m.d / 2, 0.0)], slack=_slack([back]))
         if placed is None:
             return None
         wall, (o,) = placed
-        self.wall_adjacent(wall, [o])
+        self.wall_adjacent(wall, [o], [case])
         if on_top:
             self.on_top(o, on_top, (float(self.rng.uniform(-0.5, 0.5)), 0.0))
         return o
@@ -446,14 +494,22 @@ class RoomBuilder:
             wall, prev = self.walls[i], self.walls[i - 1]
             if np.dot(prev.normal, wall.dir) < 0.99:  # not a convex right-angle corner
                 continue
-            p = wall.a + wall.dir * (w_along / 2 + self.gap(0.005)) + wall.normal * (d_in / 2 + self.gap(0.005))
+            (g_prev, c_prev), (g_wall, c_wall) = self.contact(0.005), self.contact(0.005)
+            p = wall.a + wall.dir * (w_along / 2 + g_prev) + wall.normal * (d_in / 2 + g_wall)
             yaw = wall.yaw_in + (math.pi / 2 if rotated else 0.0)
-            if self.remaining() >= 1 and self.fits([(m, float(p[0]), float(p[1]), yaw)]):
+            if self.remaining() >= 1 and self.fits([(m, float(p[0]), float(p[1]), yaw)], _slack([g_prev, g_wall])):
                 o = self.add(category, m, float(p[0]), float(p[1]), yaw)
-                self.wall_adjacent(wall, [o])
-                self.wall_adjacent(prev, [o])
+                self.wall_adjacent(wall, [o], [c_wall])
+                self.wall_adjacent(prev, [o], [c_prev])
                 return o
         return None
+
+    def turned_against_wall(self, m: Model) -> None:
+        """An armchair at 30-45 deg to a wall, its nearest corner 0-1 cm from it."""
+        turn = float(self.rng.choice([-1.0, 1.0]) * self.rng.uniform(math.radians(30), math.radians(45)))
+        placed = self.wall_group([(m.category, m, 0.0, self.gap(0.01) + _depth_along(m, turn), turn)], tries=10)
+        if placed is not None:
+            self.wall_adjacent(placed[0], placed[1], ["turned"])
 
     def clutter(self, categories: list[str], n: int) -> None:
         for _ in range(n):
@@ -461,7 +517,9 @@ class RoomBuilder:
                 return
             cat = str(self.rng.choice(categories))
             m = self.model(cat)
-            if self.rng.random() < 0.5:
+            if cat == "armchair" and self.turned():
+                self.turned_against_wall(m)
+            elif self.rng.random() < 0.5:
                 self.wall_group([(cat, m, 0.0, float(self.rng.uniform(0.05, 0.4)) + m.d / 2,
                                   float(self.rng.normal(0, 0.15)))], tries=10)
             else:
@@ -524,17 +582,19 @@ def _bathroom(r: RoomBuilder) -> None:
     r.against_wall("vanity", on_top=str(r.rng.choice(["soap", "cup", "small_plant", "candle"])))
     if r.rng.random() < 0.4:
         laundry = ["washing_machine", "dryer"] if r.rng.random() < 0.6 else ["washing_machine"]
-        pieces, x = [], 0.0
+        pieces, x, backs, joins = [], 0.0, [], []
         for cat in laundry:
             m = r.model(cat)
-            pieces.append((cat, m, x + m.w / 2, r.gap(0.006) + m.d / 2, 0.0))
-            x += m.w + r.gap()
-        placed = r.wall_group(pieces)
+            backs.append(r.contact(0.006))
+            joins.append(r.contact())
+            pieces.append((cat, m, x + m.w / 2, backs[-1][0] + m.d / 2, 0.0))
+            x += m.w + joins[-1][0]
+        placed = r.wall_group(pieces, slack=_slack([g for g, _ in backs] + [joins[0][0]]))
         if placed is not None:
             wall, objs = placed
-            r.wall_adjacent(wall, objs)
+            r.wall_adjacent(wall, objs, [c for _, c in backs])
             if len(objs) == 2:
-                r.adjacent(objs[0], objs[1])
+                r.adjacent(objs[0], objs[1], joins[0][1])
     r.clutter(["trash_can", "towel_rack", "laundry_basket", "hamper", "plant", "stool", "radiator", "shelf",
                "toilet_brush", "bath_scale", "mirror", "cabinet", "bench"], int(r.rng.integers(1, 4)))
 
@@ -570,8 +630,9 @@ def room_id(room_type: str, index: int) -> str:
 
 
 def generate_room(index: int, room_type: str, seed: int, models: dict[str, list[Model]],
-                  defect_rate: float, l_shape_rate: float) -> RoomBuilder:
-    """Generate room ``index`` of ``room_type``; deterministic in ``(seed, room_type, index)``."""
+                  defect_rate: float, l_shape_rate: float, placement: dict | None = None) -> RoomBuilder:
+    """Generate room ``index`` of ``room_type``; deterministic in ``(seed, room_type, index)``. ``placement``:
+    shares of flush, overlapping and turned placements (config ``procedural.placement``; none: clean gaps)."""
     rng = np.random.default_rng([seed, ROOM_TYPES.index(room_type), index, 7919])
     defect = str(rng.choice(DEFECTS)) if rng.random() < defect_rate else None
     content_type = room_type
@@ -582,7 +643,7 @@ def generate_room(index: int, room_type: str, seed: int, models: dict[str, list[
     if defect == "room_size":
         size = (6.4, 7.8)
     height = float(rng.uniform(4.3, 5.0)) if defect == "room_height" else float(rng.uniform(2.5, 3.0))
-    r = RoomBuilder(room_id(room_type, index), room_type, rng, models, index=index)
+    r = RoomBuilder(room_id(room_type, index), room_type, rng, models, placement=placement or {}, index=index)
     r.make_shell(bool(rng.random() < l_shape_rate), size, height)
     RECIPES[content_type](r)
     for _ in range(8):  # top up sparse rooms with clutter so clean rooms pass the object-count bounds

@@ -160,23 +160,33 @@ def strip_clearance(corners: np.ndarray, centre: np.ndarray, tangent: np.ndarray
     """Clearance from an anchor side to a convex footprint within a strip of the side: the smallest distance along
     the side's ``normal``, from the side's line, over the part of the footprint whose position along ``tangent``
     lies in ``[lo, hi]`` (negative where the footprint reaches behind the side: overlap; 0 when flush; inf where
-    it misses the strip). Exact for any yaw: the minimum lies at a corner inside the strip or where an edge
-    crosses a strip boundary.
+    it misses the strip). Exact for any yaw: see :func:`strip_span`. Returns ``(p,)``."""
+    return strip_span(corners, centre, tangent, normal, lo, hi)[0]
+
+
+def strip_span(corners: np.ndarray, centre: np.ndarray, tangent: np.ndarray, normal: np.ndarray,
+               lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The nearest and farthest reach of a convex footprint along a side's normal within a strip of the side
+    (``inf, -inf`` where it misses the strip). Exact for any yaw: the extremes lie at a corner inside the strip or
+    where an edge crosses a strip boundary.
 
     ``corners (p, k, 2)`` counter-clockwise convex outlines; ``centre``, ``tangent``, ``normal`` ``(p, 2)`` a point
-    of each side's line and its unit axes; ``lo``, ``hi`` ``(p,)`` the strip along the tangent. Returns ``(p,)``.
+    of each side's line and its unit axes; ``lo``, ``hi`` ``(p,)`` the strip along the tangent. Returns two ``(p,)``.
     """
     rel = np.asarray(corners, float) - np.asarray(centre, float)[:, None, :]
     t = np.einsum("pkj,pj->pk", rel, tangent)
     d = np.einsum("pkj,pj->pk", rel, normal)
     lo, hi = np.asarray(lo, float)[:, None], np.asarray(hi, float)[:, None]
-    best = np.where((t >= lo) & (t <= hi), d, np.inf)
+    inside = (t >= lo) & (t <= hi)
+    near, far = np.where(inside, d, np.inf), np.where(inside, d, -np.inf)
     t2, d2 = np.roll(t, -1, axis=1), np.roll(d, -1, axis=1)
     span = np.where(t2 != t, t2 - t, 1.0)
     for bound in (lo, hi):
         crosses = ((t - bound) * (t2 - bound) <= 0) & (t2 != t)
-        best = np.minimum(best, np.where(crosses, d + (bound - t) / span * (d2 - d), np.inf))
-    return best.min(axis=1)
+        at = d + (bound - t) / span * (d2 - d)
+        near = np.minimum(near, np.where(crosses, at, np.inf))
+        far = np.maximum(far, np.where(crosses, at, -np.inf))
+    return near.min(axis=1), far.max(axis=1)
 
 
 def piece_rays(starts: np.ndarray, ends: np.ndarray, inset: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:

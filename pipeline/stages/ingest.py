@@ -45,7 +45,8 @@ def ingest_procedural(config: dict, shard: int, shards: int) -> dict[str, pa.Tab
     models, model_rows = procedural.build_models(cfg["variants_per_category"], seed)
     rooms, arch, objs, gt = [], [], [], []
     for i, rt in progress(jobs, desc=f"procedural rooms, shard {shard}"):
-        r = procedural.generate_room(i, rt, seed, models, cfg["defect_rate"], cfg["l_shape_rate"])
+        r = procedural.generate_room(i, rt, seed, models, cfg["defect_rate"], cfg["l_shape_rate"],
+                                       cfg["placement"])
         room, a, o, g = procedural.room_tables(r)
         rooms.append(room)
         arch += a
