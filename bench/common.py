@@ -58,5 +58,5 @@ def ingest_and_filter(cfg: dict, p: dict[str, Path]) -> tuple[dict, object, floa
                        p["summary"], p["all_drops"])
     t_ingest = time.perf_counter() - t
     t = time.perf_counter()
-    filter_rooms.run(cfg, p["rooms"], p["architecture"], p["objects"], p["counts"], p["kept"], p["filter_report"])
+    filter_rooms.run(cfg, p["rooms"], p["architecture"], p["objects"], p["models"], p["counts"], p["kept"], p["filter_report"])
     return counts, pd.read_parquet(p["filter_report"]), t_ingest, time.perf_counter() - t

@@ -100,12 +100,14 @@ def ingest_summary(rooms: List[Path] = _files("--rooms"), objects: List[Path] = 
 @app.command("filter")
 def filter_(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
             rooms: Path = _file("--rooms"), architecture: Path = _file("--architecture"),
-            objects: Path = _file("--objects"), counts: Path = _file("--counts", "category_counts.parquet"),
+            objects: Path = _file("--objects"), models: Path = _file("--models"),
+            counts: Path = _file("--counts", "category_counts.parquet"),
             out_rooms: Path = _file("--out-rooms"), out_report: Path = _file("--out-report")) -> None:
-    """Filter one shard's rooms (every rejection has a reason)."""
+    """Filter one shard's rooms (every rejection has a reason; interpenetration measured on the meshes)."""
     from .stages import filter_rooms as stage
 
-    _summary(_stage(stage.run, config, config_json, rooms, architecture, objects, counts, out_rooms, out_report))
+    _summary(_stage(stage.run, config, config_json, rooms, architecture, objects, models, counts, out_rooms,
+                    out_report))
 
 
 @app.command("filter-report")

@@ -10,6 +10,8 @@ import pandas as pd
 import shapely
 
 from .geometry import boxes
+from .geometry.collision import mesh_penetration
+from .geometry.meshes import transform
 from .geometry.polygon import wall_loop
 from .roomdata import room_slices
 
@@ -27,7 +29,8 @@ def category_room_counts(rooms: pd.DataFrame, objects: pd.DataFrame) -> pd.DataF
 
 def _room_reasons(room, segs: np.ndarray, objs: dict, cfg: dict, rare: set) -> list[tuple[str, str]]:
     """Every rule ``room`` (a rooms row) fails, with its detail. ``segs`` (w, 2, 2) are its walls; ``objs`` holds its
-    objects' arrays (``ids``, ``categories``, ``boxes`` (n, 7), ``parents``)."""
+    objects' arrays (``ids``, ``categories``, ``boxes`` (n, 7), ``parents``, ``poses`` (n, 7), ``meshes``: per
+    object its model's mesh or None)."""
     out: list[tuple[str, str]] = []
     rtype = room.room_type
     if rtype not in cfg["min_floor_objects"]:
@@ -56,13 +59,14 @@ def _room_reasons(room, segs: np.ndarray, objs: dict, cfg: dict, rare: set) -> l
     if rare_here:
         out.append(("rare_category", f"rare in {rtype}: {', '.join(rare_here)}"))
     if len(b):
-        out += _placement_reasons(room, b, ids, objs["parents"], cfg)
+        out += _placement_reasons(room, objs, cfg)
     return out
 
 
-def _placement_reasons(room, b: np.ndarray, ids: np.ndarray, parents: np.ndarray, cfg: dict) -> list[tuple[str, str]]:
-    """outside_room and interpenetration for a room's boxes ``b`` (n, 7)."""
+def _placement_reasons(room, objs: dict, cfg: dict) -> list[tuple[str, str]]:
+    """outside_room (footprints) and interpenetration (meshes where both have one, else boxes)."""
     out = []
+    b, ids, parents = objs["boxes"], objs["ids"], objs["parents"]
     corners = boxes.footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
     outline = shapely.Polygon(np.column_stack([room.floor_x, room.floor_y]))
     pts = shapely.points(corners.reshape(-1, 2))
@@ -73,19 +77,43 @@ def _placement_reasons(room, b: np.ndarray, ids: np.ndarray, parents: np.ndarray
     depth = boxes.penetration_depths(b)
     related = (parents[:, None] == ids[None, :]) | (parents[None, :] == ids[:, None])
     depth[related] = 0.0
-    i, j = np.unravel_index(int(np.argmax(depth)), depth.shape)
-    if depth[i, j] > cfg["max_penetration"]:
-        out.append(("interpenetration", f"{ids[i]} and {ids[j]} interpenetrate by {depth[i, j]:.2f} m"))
+    worst = deepest_penetration(depth, objs, cfg)
+    if worst is not None:
+        i, j, d, measure = worst
+        out.append(("interpenetration", f"{ids[i]} and {ids[j]} interpenetrate by {d:.2f} m ({measure})"))
     return out
 
 
+def deepest_penetration(box_depth: np.ndarray, objs: dict, cfg: dict) -> tuple[int, int, float, str] | None:
+    """The first pair, deepest box overlap first, that penetrates deeper than ``max_penetration``: measured on the
+    meshes where both objects have one (``penetration.measure: mesh``), else on the boxes. None if no pair does."""
+    pen, limit = cfg["penetration"], cfg["max_penetration"]
+    i, j = np.nonzero(np.triu(box_depth > limit, 1))
+    for k in np.argsort(-box_depth[i, j], kind="stable"):
+        a, b = int(i[k]), int(j[k])
+        ma, mb = objs["meshes"][a], objs["meshes"][b]
+        if pen["measure"] == "box" or ma is None or mb is None:
+            return a, b, float(box_depth[a, b]), "boxes"
+        d = mesh_penetration(_world(ma, objs["poses"][a]), _world(mb, objs["poses"][b]), cfg["intersector"], pen)
+        if d > limit:
+            return a, b, d, "meshes"
+    return None
+
+
+def _world(mesh: tuple[np.ndarray, np.ndarray], pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A model's ``(vertices, faces)`` placed by a pose row ``(px, py, pz, yaw, sx, sy, sz)``."""
+    return transform(mesh[0], pose[:3], pose[3], pose[4:]), mesh[1]
+
+
 def filter_rooms(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.DataFrame, cfg: dict,
-                 counts: pd.DataFrame) -> pd.DataFrame:
+                 counts: pd.DataFrame, meshes: dict | None = None) -> pd.DataFrame:
     """One report row per room: kept or rejected, first rule, every rule, detail, shard (kept rooms).
 
     ``counts`` holds the dataset-wide :func:`category_room_counts` (the rare-category rule needs every room,
-    while a filter job sees one shard).
+    while a filter job sees one shard). ``meshes``: model id -> ``(vertices, faces)`` for models with a real mesh
+    (others, and every model when None, are measured as boxes); ``cfg['intersector']``: the ray backend's class.
     """
+    meshes = meshes or {}
     rare = set(map(tuple, counts.loc[counts["rooms"] < cfg["min_category_rooms"], ["room_type", "category"]]
                    .astype(str).to_numpy()))
     walls = architecture[architecture["kind"].astype(str) == "wall"].sort_values("room_id", kind="stable")
@@ -94,7 +122,9 @@ def filter_rooms(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.Da
     segs = walls[["x0", "y0", "x1", "y1"]].to_numpy(float).reshape(-1, 2, 2)
     arrays = {"ids": objs["object_id"].astype(str).to_numpy(), "categories": objs["category"].astype(str).to_numpy(),
               "boxes": objs[["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]].to_numpy(float),
-              "parents": objs["source_parent_id"].astype(object).to_numpy()}
+              "parents": objs["source_parent_id"].astype(object).to_numpy(),
+              "poses": objs[["px", "py", "pz", "yaw", "sx", "sy", "sz"]].to_numpy(float),
+              "meshes": np.array([meshes.get(m) for m in objs["model_id"].astype(object)] + [None], dtype=object)[:-1]}
     empty = slice(0, 0)
     rows = []
     for room in rooms.itertuples(index=False):

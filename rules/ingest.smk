@@ -51,12 +51,13 @@ rule filter_rooms:
         rooms=INGEST.replace("{table}", "rooms"),
         architecture=INGEST.replace("{table}", "architecture"),
         objects=INGEST.replace("{table}", "objects"),
+        models=INGEST.replace("{table}", "models"),
         counts=CATEGORY_COUNTS,
     output:
         rooms=FILTER_ROOMS,
         report=FILTER_SHARD_REPORT,
     params:
-        config=keys("filter", "floor_contact"),
+        config=keys("filter", "floor_contact", "extract.backend"),
     log:
         "logs/filter_rooms/{shard}.log",
     benchmark:
@@ -65,7 +66,7 @@ rule filter_rooms:
         ENV
     shell:
         "planit filter --config-json {params.config:q} --rooms {input.rooms} --architecture {input.architecture} "
-        "--objects {input.objects} --counts {input.counts} --out-rooms {output.rooms} --out-report {output.report} 2> {log}"
+        "--objects {input.objects} --models {input.models} --counts {input.counts} --out-rooms {output.rooms} --out-report {output.report} 2> {log}"
 
 
 rule filter_report:

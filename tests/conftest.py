@@ -108,3 +108,15 @@ def shared_data(sub: str) -> Path:
     if not path.exists():
         pytest.skip(f"real sample data not found at {path} (set PLANIT_SHARED_DATA; a fresh clone has no ../shared)")
     return path
+
+
+def table_mesh(w, d, h, top=0.03, leg=0.05):
+    """A four-legged table (model frame: bottom centre at the origin)."""
+    legs = [meshes.box((leg, leg, h - top), (sx * (w / 2 - leg), sy * (d / 2 - leg), (h - top) / 2))
+            for sx in (-1, 1) for sy in (-1, 1)]
+    return meshes.combine([meshes.box((w, d, top), (0, 0, h - top / 2)), *legs])
+
+
+def l_sofa_mesh():
+    """An L-shaped sofa: a 2.4 x 0.9 m seat along y = -0.75 and a 0.9 x 1.6 m chaise along x = +0.75 (local)."""
+    return meshes.combine([meshes.box((2.4, 0.9, 0.8), (0.0, -0.75, 0.4)), meshes.box((0.9, 1.6, 0.8), (0.75, 0.4, 0.4))])

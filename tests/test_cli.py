@@ -36,7 +36,7 @@ def test_stats_on_bad_input_names_the_file(tmp_path):
 
 def test_stage_with_missing_input_fails_cleanly(tmp_path):
     f = tmp_path / "f"
-    out = planit("filter", "--rooms", str(tmp_path / "nowhere/rooms-0.parquet"), "--architecture", "a", "--objects", "o",
+    out = planit("filter", "--rooms", str(tmp_path / "nowhere/rooms-0.parquet"), "--architecture", "a", "--objects", "o", "--models", "m",
                  "--counts", "c", "--out-rooms", str(f / "rooms.parquet"), "--out-report", str(f / "report.parquet"))
     assert out.returncode == 2 and "nowhere/rooms-0.parquet" in out.stderr and "Traceback" not in out.stderr
     assert len(out.stderr.strip().splitlines()) <= 2  # the log line and the error line
@@ -45,7 +45,7 @@ def test_stage_with_missing_input_fails_cleanly(tmp_path):
 
 def test_stage_with_malformed_input_names_the_field(tmp_path):
     pq.write_table(pa.table({"room_id": ["r1"]}), tmp_path / "rooms.parquet")
-    out = planit("filter", "--rooms", str(tmp_path / "rooms.parquet"), "--architecture", "a", "--objects", "o",
+    out = planit("filter", "--rooms", str(tmp_path / "rooms.parquet"), "--architecture", "a", "--objects", "o", "--models", "m",
                  "--counts", "c", "--out-rooms", str(tmp_path / "k.parquet"), "--out-report", str(tmp_path / "r.parquet"))
     assert out.returncode == 2 and "rooms.parquet" in out.stderr and "source" in out.stderr
 

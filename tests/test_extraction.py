@@ -7,7 +7,7 @@ from hypothesis import given, strategies as st
 
 from pipeline.corpus import catalog
 from pipeline.geometry import relations
-from conftest import Room, default_config, edge
+from conftest import Room, default_config, edge, l_sofa_mesh, table_mesh
 
 DIST = default_config()["extract"]["distance"]
 
@@ -311,20 +311,6 @@ def test_reported_gap_is_the_exact_clearance_for_any_yaw_and_overlap(pair):
 
 
 # ------------------------------------------------------------------ support on meshes (issue 11)
-def table_mesh(w, d, h, top=0.03, leg=0.05):
-    from pipeline.geometry import meshes as M
-
-    legs = [M.box((leg, leg, h - top), (sx * (w / 2 - leg), sy * (d / 2 - leg), (h - top) / 2)) for sx in (-1, 1) for sy in (-1, 1)]
-    return M.combine([M.box((w, d, top), (0, 0, h - top / 2)), *legs])
-
-
-def l_sofa_mesh():
-    """An L-shaped sofa: a 2.4 x 0.9 m seat along y = -0.75 and a 0.9 x 1.6 m chaise along x = +0.75 (local)."""
-    from pipeline.geometry import meshes as M
-
-    return M.combine([M.box((2.4, 0.9, 0.8), (0.0, -0.75, 0.4)), M.box((0.9, 1.6, 0.8), (0.75, 0.4, 0.4))])
-
-
 def test_chair_under_a_four_legged_table_is_not_supported_by_it():
     r = square_room(5.0)
     r.add("table", "desk", (1.4, 0.7, 0.75), (2.5, 2.5), mesh=table_mesh(1.4, 0.7, 0.75))

@@ -182,7 +182,7 @@ def test_ithor_real_rooms_support_parents_agree(tmp_path):
     assert len(rooms) == 120 and Counter(rooms.room_type) == {"bedroom": 30, "living": 30, "kitchen": 30, "bathroom": 30}
     ingest_summary.run([outs["rooms"]], [outs["objects"]], [outs["models"]], [outs["ingest_report"]], [outs["drops"]],
                        t / "counts.parquet", t / "rep.parquet", t / "drops.parquet")
-    filter_rooms.run(cfg, outs["rooms"], outs["architecture"], outs["objects"], t / "counts.parquet", t / "kept.parquet",
+    filter_rooms.run(cfg, outs["rooms"], outs["architecture"], outs["objects"], outs["models"], t / "counts.parquet", t / "kept.parquet",
                      t / "filter.parquet")
     symmetry.run(cfg, [outs["models"]], t / "sym.parquet", t / "sym.json")
     extract_graphs.run(cfg, 0, t / "kept.parquet", outs["architecture"], outs["objects"], outs["models"], t / "sym.parquet",

@@ -31,6 +31,9 @@ ROOM_SIZE = {  # (min, max) extent in m along each axis
 }
 DEFECTS = ("wall_loop", "mislabeled", "interpenetration", "rare_category", "room_size", "room_height")
 MAX_OBJECTS = 20
+# closed bodies (no legs, no raised frame, not hollow): an ottoman pushed into one penetrates its mesh, not only its box
+SOLID = {"wardrobe", "dresser", "bookshelf", "kitchen_cabinet", "sink_cabinet", "refrigerator", "washing_machine", "dryer",
+         "vanity", "tv_stand", "sideboard", "filing_cabinet", "cabinet", "pantry", "dishwasher", "stove"}
 
 
 @dataclass
@@ -666,7 +669,8 @@ def _apply_defect(r: RoomBuilder, defect: str) -> None:
         wall["x1"] = wall["x0"] + t * (wall["x1"] - wall["x0"])
         wall["y1"] = wall["y0"] + t * (wall["y1"] - wall["y0"])
     elif defect == "interpenetration":
-        big = [o for o in r.objects if o.parent is None and min(o.model.w, o.model.d) >= 0.4 and o.model.h >= 0.4]
+        big = [o for o in r.objects if o.parent is None and o.category in SOLID and min(o.model.w, o.model.d) >= 0.4
+               and o.model.h >= 0.4]
         if not big:
             return
         host = big[int(r.rng.integers(len(big)))]

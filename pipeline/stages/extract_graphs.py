@@ -23,11 +23,8 @@ def load_shard(rooms: Path, architecture: Path, objects: Path, models: Path):
     ids = room_df["room_id"].tolist()
     arch = tables.read(architecture, "architecture", filters=[("room_id", "in", ids)]).to_pandas()
     objs = tables.read(objects, "objects", filters=[("room_id", "in", ids)]).to_pandas()
-    used = sorted(set(objs["model_id"].dropna()))
-    rows = tables.read(models, "models", filters=[("model_id", "in", used)],
-                       columns=["model_id", "vertices", "faces", "mesh_kind"]).to_pylist()
-    box_models = {m["model_id"] for m in rows if m["mesh_kind"] == "box_fallback"}
-    return room_df, arch, objs, {m["model_id"]: tables.model_mesh(m) for m in rows}, box_models
+    meshes, box_models = tables.read_meshes(models, objs["model_id"].dropna())
+    return room_df, arch, objs, meshes, box_models
 
 
 def run(config: dict, shard: int, rooms: Path, architecture: Path, objects: Path, models: Path, symmetry: Path,

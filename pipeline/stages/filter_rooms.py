@@ -9,17 +9,22 @@ import pyarrow as pa
 from .. import tables
 from ..config import config_hash
 from ..filtering import filter_rooms
+from ..geometry.raycast import intersector_class
 
 log = logging.getLogger("planit.filter")
 
 
-def run(config: dict, rooms: Path, architecture: Path, objects: Path, counts: Path, out_rooms: Path,
+def run(config: dict, rooms: Path, architecture: Path, objects: Path, models: Path, counts: Path, out_rooms: Path,
         out_report: Path) -> dict:
     """Write the shard's kept rooms (``rooms`` schema) and its filter report."""
     room_df = tables.read(rooms, "rooms").to_pandas()
-    report = filter_rooms(room_df, tables.read(architecture, "architecture").to_pandas(),
-                          tables.read(objects, "objects").to_pandas(), {**config["filter"], "floor_contact": config["floor_contact"]},
-                          tables.read(counts, "category_counts").to_pandas())
+    obj_df = tables.read(objects, "objects").to_pandas()
+    meshes, box_models = tables.read_meshes(models, obj_df["model_id"].dropna())
+    cfg = {**config["filter"], "floor_contact": config["floor_contact"],
+           "intersector": intersector_class(config["extract"]["backend"])}
+    report = filter_rooms(room_df, tables.read(architecture, "architecture").to_pandas(), obj_df, cfg,
+                          tables.read(counts, "category_counts").to_pandas(),
+                          {k: v for k, v in meshes.items() if k not in box_models})
     kept = room_df[room_df["room_id"].isin(report.loc[report["status"] == "kept", "room_id"])]
     extra = {"config_hash": config_hash(config["filter"])}
     tables.write(out_report, "filter_report", pa.Table.from_pandas(report, preserve_index=False), extra)

@@ -1,0 +1,73 @@
+"""Interpenetration depth between two objects' meshes, with Embree: one implementation for every collision check.
+
+Boxes overstate overlap wherever a shape is not a box (an L-shaped sofa's box swallows its coffee table, a table's
+box holds the chair tucked under it). Where both objects have a mesh, the depth is measured on the meshes: the
+overlap of their boxes is sampled on a grid, each point is tested inside or outside each mesh by ray parity (three
+skewed directions, majority vote, so a mesh with small holes still reads right), and the depth is the thickness of
+the region inside both: twice its largest inscribed radius (a Euclidean distance transform). For a slab of overlap,
+or a box corner pushed into a box, that is the smallest push that clears it; a corner turned 45 deg reads 0.83 of its
+depth (the wedge's inscribed diameter). Accurate to one grid pitch.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+from .raycast import RoomScene
+
+# skewed so that rays do not graze the axis-aligned faces and edges furniture is made of
+DIRECTIONS = np.array([[1.0, 0.137, 0.071], [-0.113, 1.0, 0.059], [0.067, -0.091, 1.0]])
+DIRECTIONS /= np.linalg.norm(DIRECTIONS, axis=1, keepdims=True)
+
+
+def box_overlap(lo_a: np.ndarray, hi_a: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The axis-aligned overlap ``(lo (3,), hi (3,))`` of two axis-aligned boxes (empty where any ``hi <= lo``)."""
+    return np.maximum(lo_a, lo_b), np.minimum(hi_a, hi_b)
+
+
+def grid(lo: np.ndarray, hi: np.ndarray, resolution: int, min_pitch: float, max_cells: int) -> tuple[np.ndarray, float]:
+    """Cell centres ``(nx, ny, nz, 3)`` over the box ``[lo, hi]`` with one empty cell of padding on each side, and the
+    pitch: fine enough for ``resolution`` cells along the longest side and 6 across the thinnest, never below
+    ``min_pitch``, coarsened until at most ``max_cells`` cells."""
+    size = np.maximum(hi - lo, 1e-9)
+    pitch = max(min(float(size.max()) / resolution, float(size.min()) / 6), min_pitch)
+    pitch = max(pitch, float(np.prod(size)) ** (1 / 3) / max_cells ** (1 / 3))
+    axes = [np.arange(a - pitch / 2, b + pitch, pitch) for a, b in zip(lo, hi)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1), pitch
+
+
+def inside(scene: RoomScene, points: np.ndarray, owners: int) -> np.ndarray:
+    """``(n, owners)`` bool: each point inside each owner's mesh, by the parity of the crossings of a ray in each
+    of :data:`DIRECTIONS`; the majority of the three decides."""
+    n = len(points)
+    odd = np.zeros((n, owners), dtype=np.int64)
+    for d in DIRECTIONS:
+        crossings = np.zeros((n, owners), dtype=np.int64)
+
+        def count(ray, owner, layer, face):  # every hit is refused, so the scene steps through them all
+            np.add.at(crossings, (ray, owner), 1)
+            return np.zeros(len(ray), dtype=bool)
+
+        scene.first_accepted(points, np.broadcast_to(d, points.shape), count, max_steps=1024)
+        odd += crossings % 2
+    return odd >= 2
+
+
+def thickness(mask: np.ndarray, pitch: float) -> float:
+    """Thickness (m) of a voxel region, within a pitch: twice its largest inscribed radius (the distance from a cell
+    centre to the nearest outside cell centre, so half a cell too much on each side); 0 when empty."""
+    if not mask.any():
+        return 0.0
+    return (2.0 * float(ndimage.distance_transform_edt(mask).max()) - 1.0) * pitch + pitch / 2
+
+
+def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], intersector, cfg: dict) -> float:
+    """Penetration depth (m) of two meshes in world coordinates, each ``(vertices (n, 3), faces (m, 3))``; ``cfg``:
+    ``resolution``, ``min_pitch`` (m) and ``max_cells`` of the sampling grid."""
+    lo, hi = box_overlap(a[0].min(0), a[0].max(0), b[0].min(0), b[0].max(0))
+    if np.any(hi <= lo):
+        return 0.0
+    cells, pitch = grid(lo, hi, cfg["resolution"], cfg["min_pitch"], cfg["max_cells"])
+    scene = RoomScene([a, b], np.array([0, 1]), np.array([0, 0]), intersector)
+    both = inside(scene, cells.reshape(-1, 3), 2).all(axis=1).reshape(cells.shape[:3])
+    return thickness(both, pitch)
