@@ -179,6 +179,10 @@ def test_box_contact_rules_for_box_only_sources():
     r.add("sink", "sink", (0.5, 0.4, 0.25), (1.5, 3.6), z=0.67)  # hangs through the slab: nothing below it
     parents = {n["node_id"]: n["parent_id"] for n in r.extract().nodes}
     assert parents["pillow"] == "bed" and parents["sink"] == "slab" and parents["slab"] is None
+    r.add("desk", "desk", (1.2, 0.6, 1.4), (4.0, 2.0), yaw_deg=90)  # with a hutch: its box rises to 1.4 m
+    r.add("chair", "chair", (0.5, 0.5, 0.9), (3.8, 2.0))  # tucked under it: its back rises above the 0.73 m top
+    r.add("bowl", "bowl", (0.18, 0.18, 0.08), (3.75, 2.05), z=0.73)
+    assert {n["node_id"]: n["parent_id"] for n in r.extract().nodes}["bowl"] == "desk"
     cfg = default_config()
     cfg["extract"]["support"]["inside_box_contact"] = False
     parents = {n["node_id"]: n["parent_id"] for n in r.extract(cfg=cfg["extract"]).nodes}

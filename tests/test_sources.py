@@ -189,7 +189,7 @@ def test_ithor_real_rooms_support_parents_agree(tmp_path):
                        t / "nodes.parquet", t / "edges.parquet", t / "summary.json")
     metrics = score_extraction.run([t / "nodes.parquet"], [t / "edges.parquet"], [outs["ground_truth"]], t / "m.json")
     assert metrics["supported_objects"] > 1500
-    assert metrics["support_parent_recall"] >= 0.95
+    assert metrics["support_parent_recall"] >= 0.965  # measured 0.9682 (goal 0.98: docs/real-data.md)
 
 
 # ----------------------------------------------------------------------------------------------- SUNCG
