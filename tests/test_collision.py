@@ -107,3 +107,17 @@ def test_real_furniture_meshes_overlap_far_less_than_their_boxes(tmp_path):
     assert len(mesh_depths) >= 8
     assert sum(box_only) >= 6  # overlaps that exist only between the boxes no longer reject their rooms
     assert np.median(mesh_depths) < 0.05
+    # the same rooms extracted: the sample's furniture all stands on the floor (some meshes float mm above it),
+    # so no support edge may join two pieces of it (a sofa 1.2 mm up once became its coffee table's child)
+    from pipeline.stages import extract_graphs, symmetry
+
+    cfg = config.validate({"source": "front3d", "shards": 1})
+    ing = tmp_path / "ingest"
+    symmetry.run(cfg, [ing / "models-0.parquet"], tmp_path / "sym.parquet", tmp_path / "sym.json")
+    extract_graphs.run(cfg, 0, ing / "rooms-0.parquet", ing / "architecture-0.parquet", ing / "objects-0.parquet",
+                       ing / "models-0.parquet", tmp_path / "sym.parquet", tmp_path / "n.parquet", tmp_path / "e.parquet",
+                       tmp_path / "s.json")
+    nodes = pd.read_parquet(tmp_path / "n.parquet")
+    edges = pd.read_parquet(tmp_path / "e.parquet")
+    assert len(nodes[nodes.kind == "object"]) >= 100
+    assert (nodes[nodes.kind == "object"].tier == 1).all() and not (edges.edge_type == "support").any()
