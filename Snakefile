@@ -12,6 +12,7 @@ include: "rules/common.smk"
 include: "rules/ingest.smk"
 include: "rules/extract.smk"
 include: "rules/refine.smk"
+include: "rules/graph_model.smk"
 
 
 rule all:

@@ -225,12 +225,73 @@ def graph_report(nodes: Path = _file("--nodes"), edges: Path = _file("--edges"),
     _summary(_guard(stage.run, nodes, edges, superstructures, outs))
 
 
+@app.command("train-graph-model")
+def train_graph_model(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                      room_type: str = typer.Option(..., "--room-type"), nodes: Path = _file("--nodes", "final nodes"),
+                      edges: Path = _file("--edges", "final edges"), out_model: Path = _file("--out-model"),
+                      out_history: Path = _file("--out-history", "loss per epoch (CSV)"),
+                      out_curve: Path = _file("--out-curve", "loss curves (PNG)"),
+                      out_summary: Path = _file("--out-summary", "training summary (JSON)")) -> None:
+    """Train the graph generative model of one room type (resumes from the checkpoint beside --out-model)."""
+    from .stages import train_graph_model as stage
+
+    _summary(_stage(stage.run, config, config_json, room_type, nodes, edges, out_model, out_history, out_curve,
+                    out_summary), skip=("preset",))
+
+
+@app.command("sample-graphs")
+def sample_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                  room_type: Optional[str] = typer.Option(None, "--room-type", help="default: the spec's room_type"),
+                  model: Optional[Path] = typer.Option(None, "--model", help="default: results/graph_model/<type>/model.pt"),
+                  nodes: Path = typer.Option(Path("results/graphs/ingested/nodes.parquet"), "--nodes"),
+                  edges: Path = typer.Option(Path("results/graphs/ingested/edges.parquet"), "--edges"),
+                  spec: Optional[Path] = typer.Option(None, "--spec", help="complete this partial graph (YAML)"),
+                  n: Optional[int] = typer.Option(None, "-n", "--count", help="graphs (default graph_model.sample.graphs)"),
+                  out_nodes: Optional[Path] = typer.Option(None, "--out-nodes"),
+                  out_edges: Optional[Path] = typer.Option(None, "--out-edges"),
+                  out_summary: Optional[Path] = typer.Option(None, "--out-summary")) -> None:
+    """Sample relation graphs of a room type, from scratch or completing --spec; writes generated_{nodes,edges}."""
+    from .stages import sample_graphs as stage
+
+    if room_type is None:
+        if spec is None:
+            _fail("give --room-type or --spec")
+        room_type = _guard(stage.spec_room_type, spec)
+    folder = Path("results/graph_model") / room_type / ("completed" if spec else "sampled")
+    model = model or Path("results/graph_model") / room_type / "model.pt"
+    _summary(_stage(stage.run, config, config_json, room_type, model, nodes, edges, out_nodes or folder / "nodes.parquet",
+                    out_edges or folder / "edges.parquet", out_summary or folder / "summary.json", spec, n),
+             skip=("rejections",))
+
+
+@app.command("graph-model-metrics")
+def graph_model_metrics(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                        room_type: str = typer.Option(..., "--room-type"), model: Path = _file("--model"),
+                        history: Path = _file("--history"), nodes: Path = _file("--nodes"), edges: Path = _file("--edges"),
+                        gen_nodes: Path = _file("--gen-nodes"), gen_edges: Path = _file("--gen-edges"),
+                        sample_summary: Path = _file("--sample-summary"), out: Path = _file("--out")) -> None:
+    """Evaluate a room type's graph model (held-out NLL; generated vs held-out graphs beside the sampling floor)."""
+    from .stages import graph_model_metrics as stage
+
+    result = _stage(stage.run, config, config_json, room_type, model, history, nodes, edges, gen_nodes, gen_edges,
+                    sample_summary, out)
+    typer.echo(json.dumps(result["goals"]))
+
+
 @app.command()
-def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, or 'graphs' / a folder of gathered graph tables"),
+def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, 'graphs' / a folder of gathered graph tables, "
+                                               "or 'graph_model' / a metrics JSON"),
           room: Optional[str] = typer.Option(None, "--room", help="print this room's graph")) -> None:
     """Print a table's schema, row count and per-column summary; for graphs, the per-room-type report. Reads only."""
     if str(path) == "graphs" and not path.exists():
         path = Path("results/graphs/ingested")
+    if str(path) == "graph_model" and not path.exists():
+        path = Path("results/graph_model")
+    if path.is_dir() and (path / "metrics.json").exists() or path.suffix == ".json" or path.name == "graph_model":
+        from .inspect import print_metrics
+
+        _guard(print_metrics, path, sys.stdout)
+        return
     if path.is_dir():
         from .graphs.report import graph_report as report_of, graph_tables, print_report, print_room
 

@@ -36,3 +36,41 @@ def table_summary(path: str | Path, stream: TextIO) -> None:
                                                         "" if s[5] is None else f"{float(s[5]):.4g}", str(s[11])]
         t.add_row(field.name, str(field.type), meta.get("unit", ""), *cells)
     console.print(t)
+
+
+def _flat(value, prefix: str = "") -> list[tuple[str, object]]:
+    if isinstance(value, dict):
+        return [kv for k, v in value.items() for kv in _flat(v, f"{prefix}{k}.")]
+    return [(prefix.rstrip("."), value)]
+
+
+def print_metrics(path: str | Path, stream: TextIO) -> None:
+    """Graph-model metrics side by side: one column per room type (``path``: a metrics JSON, a room type's folder,
+    or the graph_model folder holding one folder per room type)."""
+    import json
+
+    path = Path(path)
+    files = ([path] if path.suffix == ".json" else [path / "metrics.json"] if (path / "metrics.json").exists()
+             else sorted(path.glob("*/metrics.json")))
+    if not files:
+        raise tables.TableError(f"{path}: no metrics.json (written by rule graph_model_metrics)")
+    columns = {}
+    for f in files:
+        try:
+            columns[f.parent.name if f.name == "metrics.json" else f.stem] = dict(_flat(json.loads(f.read_text())))
+        except (OSError, ValueError) as exc:
+            raise tables.TableError(f"{f}: unreadable metrics ({exc})") from exc
+    table = Table(title=f"graph model metrics ({path})")
+    table.add_column("metric")
+    for name in columns:
+        table.add_column(name, justify="right")
+    keys = list(dict.fromkeys(k for c in columns.values() for k in c))
+    for k in keys:
+        table.add_row(k, *(_show(c.get(k)) for c in columns.values()))
+    Console(file=stream, width=200).print(table)
+
+
+def _show(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return "" if v is None else str(v)

@@ -196,6 +196,11 @@ SCHEMAS["final_edges"] = pa.schema([*SCHEMAS["edges"],
                                     _f("rule", _CAT, doc="the rule that kept or pruned the edge (docs/data-model.md lists them)"),
                                     _f("origin", _CAT, doc="raw (extracted) | derived (added by hub/chain inheritance or connectivity)"),
                                     _f("group_id", _STR, doc="hub or chain whose edge this is")])
+_GENERATED = [_f("scene_id", _STR, doc="generated scene (= room_id)"),
+              _f("source_room_id", _STR, doc="the held-out room whose architecture the scene grew from"),
+              _f("sample_seed", pa.int64(), doc="seed of the sampling batch")]
+SCHEMAS["generated_nodes"] = pa.schema([*SCHEMAS["final_nodes"], *_GENERATED])
+SCHEMAS["generated_edges"] = pa.schema([*SCHEMAS["final_edges"], *_GENERATED])
 SCHEMAS["superstructures"] = pa.schema([
     _f("room_id", _STR, nullable=False), _f("room_type", _CAT),
     _f("group_id", _STR, doc="hub_<k> | chain_<k>, unique within the room"),
@@ -242,7 +247,7 @@ SCHEMAS["category_sizes"] = pa.schema([
 # Rows are unique by these columns; the write refuses a duplicate.
 KEYS = {"rooms": ["room_id"], "architecture": ["room_id", "element_id"], "objects": ["room_id", "object_id"],
         "models": ["model_id"], "symmetry": ["model_id"], "nodes": ["room_id", "node_id"],
-        "final_nodes": ["room_id", "node_id"], "filter_report": ["room_id"]}
+        "final_nodes": ["room_id", "node_id"], "filter_report": ["room_id"], "generated_nodes": ["room_id", "node_id"]}
 # The rule that writes each kind of table: a missing or corrupt one is reported with the rule to rerun.
 PRODUCERS = {"rooms": "ingest or filter_rooms", "architecture": "ingest", "objects": "ingest", "models": "ingest",
              "ground_truth": "ingest", "ingest_report": "ingest or ingest_summary", "drops": "ingest or ingest_summary",
@@ -251,7 +256,8 @@ PRODUCERS = {"rooms": "ingest or filter_rooms", "architecture": "ingest", "objec
              "superstructures": "shard_statistics, refine_graphs or gather_graphs",
              "cooccurrence": "graph_statistics", "relations": "graph_statistics", "hub_patterns": "graph_statistics",
              "category_sizes": "graph_statistics", "final_nodes": "refine_graphs or gather_graphs",
-             "final_edges": "refine_graphs or gather_graphs"}
+             "final_edges": "refine_graphs or gather_graphs", "generated_nodes": "sample_graphs",
+             "generated_edges": "sample_graphs"}
 
 
 def _made_by(name: str | None) -> str:
@@ -354,6 +360,11 @@ def _atomic(path: Path, write_to) -> Path:
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def write_atomic(path: str | Path, write_to) -> Path:
+    """Any file written atomically: ``write_to(temporary path)``, then a rename (checkpoints, model files)."""
+    return _atomic(Path(path), write_to)
 
 
 def write_json(path: str | Path, value) -> Path:

@@ -27,6 +27,7 @@ ENV = "../environment.yml"
 wildcard_constraints:
     corpus="[a-z][a-z0-9_]*",
     shard="[0-9]+",
+    room_type="[a-z][a-z0-9_]*",
 
 
 # ------------------------------------------------------------------------------------------- paths
@@ -52,6 +53,9 @@ FINAL_SUMMARY = "results/graphs/{corpus}/final/summary-{shard}.json"
 GATHERED = "results/graphs/{corpus}/{table}.parquet"
 REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
+GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
+# what training reads (sampling settings are not among them: changing them resamples without retraining)
+GRAPH_TRAIN_KEYS = ["room_types", "preset", "presets", "max_edges", "heldout_fraction", "device", "threads"]
 
 
 def keys(*dotted):
@@ -98,8 +102,14 @@ def get_corpus_ground_truth(wildcards):
     return [corpus_path(wildcards.corpus, "ground_truth", k) for k in SHARDS]
 
 
+def graph_room_types():
+    """Room types with a graph model: graph_model.room_types, else every type the filter knows."""
+    return config["graph_model"]["room_types"] or list(config["filter"]["min_floor_objects"])
+
+
 def get_final_outputs():
     return [
+        *expand(GRAPH_MODEL, room_type=graph_room_types(), name=["metrics.json", "loss.png"]),
         FILTER_REPORT,
         INGEST_REPORT,
         DROPS,

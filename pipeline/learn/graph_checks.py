@@ -1,0 +1,56 @@
+"""Validity of a generated relation graph (PlanIT section 5's rejection rules). networkx, no torch.
+
+A graph is rejected when it is disconnected (an object not joined to the room), cyclic among objects (a directed
+cycle of object edges: refinement leaves real graphs acyclic), holds an edge type never seen between those two
+categories in training, or has an inconsistent chain (a chain member with no adjacent or proximal edge to another
+chain member; kitchen rows mix categories).
+"""
+from __future__ import annotations
+
+import networkx as nx
+
+from .graph_data import N_OBJECT_EDGES, OBJECT_EDGES, ROLES
+
+CHAIN_ROLES = {ROLES.index("chain"), ROLES.index("hub+chain")}
+NEAR = {k for k, name in enumerate(OBJECT_EDGES) if name.endswith(("adjacent", "proximal"))}
+REASONS = ("disconnected", "cyclic", "unseen_edge", "inconsistent_chain")
+
+
+def seen_triples(graphs) -> set[tuple[int, int, int]]:
+    """(anchor class, target class, edge class) of every object edge in ``graphs`` (objects with ``node_class``
+    and ``edges``)."""
+    out = set()
+    for g in graphs:
+        cls = list(g.node_class)
+        out |= {(cls[s], cls[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES}
+    return out
+
+
+def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
+             seen: set[tuple[int, int, int]]) -> list[str]:
+    """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class)."""
+    out = []
+    n = len(node_class)
+    undirected = nx.Graph()
+    undirected.add_nodes_from(range(n))
+    undirected.add_edges_from((s, t) for s, t, _ in edges)
+    if n and not nx.is_connected(undirected):
+        out.append("disconnected")
+    objects = nx.DiGraph()
+    objects.add_edges_from((s, t) for s, t, c in edges if c < N_OBJECT_EDGES and s >= n_arch and t >= n_arch)
+    if not nx.is_directed_acyclic_graph(objects):
+        out.append("cyclic")
+    if any(c < N_OBJECT_EDGES and (node_class[s], node_class[t], c) not in seen for s, t, c in edges):
+        out.append("unseen_edge")
+    if not _chains_consistent(node_class, role, edges, n_arch):
+        out.append("inconsistent_chain")
+    return out
+
+
+def _chains_consistent(node_class, role, edges, n_arch) -> bool:
+    members = {k for k in range(n_arch, len(node_class)) if role[k] in CHAIN_ROLES}
+    linked = set()
+    for s, t, c in edges:
+        if c in NEAR and s in members and t in members:
+            linked |= {s, t}
+    return members == linked

@@ -1,0 +1,121 @@
+"""Training the graph model: batched teacher forcing, Adam, early stopping on held-out NLL, checkpoints that resume.
+
+Every epoch draws new random node and edge orders from ``(seed, epoch)`` alone, so a run resumed from its
+checkpoint continues exactly as an uninterrupted one would (same orders, same optimizer state, same weights).
+The held-out NLL uses one fixed order per graph. The checkpoint (written atomically after every epoch) carries the
+config hash: a checkpoint of other settings is never resumed.
+"""
+from __future__ import annotations
+
+import copy
+import logging
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from .. import tables
+from .graph_data import Graph, Vocab, sequence
+from .graph_model import GraphModel
+from .teacher import KINDS, make_batch, nll
+
+log = logging.getLogger("planit.graph_model")
+
+
+def pick_device(setting: str) -> str:
+    """'auto': CUDA when PyTorch sees a GPU, else the CPU."""
+    if setting == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    return setting
+
+
+def build_model(vocab: Vocab, preset: dict) -> GraphModel:
+    return GraphModel(vocab.feature_size, len(vocab.categories), preset["hidden"], preset["width"], preset["rounds"],
+                      preset["message"])
+
+
+@dataclass
+class Run:
+    """What training returns: the best weights, the loss history (one row per epoch) and the settings."""
+    model: GraphModel
+    history: list[dict]
+    best_epoch: int
+    resumed_from: int
+
+
+def heldout_nll(model: GraphModel, graphs: list[Graph], vocab: Vocab, seed: int, max_edges: int, batch_size: int,
+                device: str) -> np.ndarray:
+    """``(len(graphs), 3)`` NLL per held-out graph and decision kind, one fixed order per graph."""
+    rng = np.random.default_rng([seed, 77])
+    seqs = [sequence(g, rng, max_edges) for g in graphs]
+    out = []
+    with torch.no_grad():
+        for k in range(0, len(seqs), batch_size):
+            out.append(nll(model, make_batch(seqs[k:k + batch_size], vocab, device)).cpu().numpy())
+    return np.concatenate(out) if out else np.zeros((0, len(KINDS)))
+
+
+def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) -> tuple[float, int]:
+    """One pass over the training graphs in batches; returns the mean NLL per graph and edges dropped."""
+    rng = np.random.default_rng([seed, epoch])
+    order = rng.permutation(len(graphs))
+    seqs = [sequence(graphs[i], rng, max_edges) for i in order]
+    total, dropped = 0.0, sum(s.dropped for s in seqs)
+    for k in range(0, len(seqs), preset["batch_size"]):
+        part = seqs[k:k + preset["batch_size"]]
+        loss = nll(model, make_batch(part, vocab, device)).sum(1)
+        opt.zero_grad()
+        loss.mean().backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), preset["clip"])
+        opt.step()
+        total += float(loss.detach().sum())
+    return total / max(len(seqs), 1), dropped
+
+
+def train(train_graphs: list[Graph], held: list[Graph], vocab: Vocab, preset: dict, max_edges: int, seed: int,
+          checkpoint: Path, config_hash: str, device: str = "cpu", progress=None) -> Run:
+    """Train until the held-out NLL has not improved by ``preset['min_improvement']`` (relative) for
+    ``preset['patience']`` epochs, or ``preset['max_epochs']``. ``progress(epoch, row)`` is called per epoch."""
+    torch.manual_seed(seed)
+    model = build_model(vocab, preset).to(device)
+    opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
+    state = {"epoch": 0, "history": [], "best": np.inf, "best_epoch": 0, "best_state": None, "stale": 0}
+    resumed = 0
+    if checkpoint.exists():
+        saved = torch.load(checkpoint, map_location=device, weights_only=False)
+        if saved.get("config_hash") == config_hash:
+            model.load_state_dict(saved["model"])
+            opt.load_state_dict(saved["optimizer"])
+            state = saved["state"]
+            resumed = state["epoch"]
+            log.info("resumed from %s after epoch %d", checkpoint, resumed)
+        else:
+            log.info("checkpoint %s is for other settings: starting afresh", checkpoint)
+    while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
+        epoch = state["epoch"] + 1
+        start = time.perf_counter()
+        model.train()
+        train_nll, dropped = _epoch(model, opt, train_graphs, vocab, seed, epoch, preset, max_edges, device)
+        seconds = time.perf_counter() - start
+        model.eval()
+        held_nll = heldout_nll(model, held, vocab, seed, max_edges, preset["batch_size"], device)
+        row = {"epoch": epoch, "train_nll": train_nll, "heldout_nll": float(held_nll.sum(1).mean()),
+               **{f"heldout_{k}": float(held_nll[:, i].mean()) for i, k in enumerate(KINDS)},
+               "seconds": seconds, "graphs_per_s": len(train_graphs) / max(seconds, 1e-9), "edges_dropped": dropped}
+        state["history"].append(row)
+        if row["heldout_nll"] < state["best"] * (1 - preset["min_improvement"]):
+            state["stale"] = 0
+        else:
+            state["stale"] += 1
+        if row["heldout_nll"] < state["best"]:
+            state.update(best=row["heldout_nll"], best_epoch=epoch, best_state=copy.deepcopy(model.state_dict()))
+        state["epoch"] = epoch
+        tables.write_atomic(checkpoint, lambda tmp: torch.save({"config_hash": config_hash, "model": model.state_dict(),
+                                                                "optimizer": opt.state_dict(), "state": state}, tmp))
+        if progress:
+            progress(epoch, row)
+    if state["best_state"] is not None:
+        model.load_state_dict(state["best_state"])
+    return Run(model, state["history"], state["best_epoch"], resumed)

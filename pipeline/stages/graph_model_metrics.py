@@ -1,0 +1,87 @@
+"""Evaluate one room type's graph model: held-out NLL, generated vs held-out real graphs beside the sampling
+floor, validity, novelty, uniqueness and (procedural corpus) the generator's own arrangement rules."""
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import tables
+
+log = logging.getLogger("planit.graph_model_metrics")
+
+# the issue's quality goals: each distance within this factor of its floor
+FLOOR_FACTOR = 1.5
+
+
+def _rule_view(g, vocab):
+    """(categories, edges with kind names) of a graph, for the procedural rules."""
+    from ..learn.graph_data import EDGE_CLASSES
+
+    cats = [vocab.node_classes[c] for c in g.node_class]
+    return cats, [(int(s), int(t), EDGE_CLASSES[int(c)]) for s, t, c in g.edges]
+
+
+def run(config: dict, room_type: str, model: Path, history: Path, nodes: Path, edges: Path, gen_nodes: Path,
+        gen_edges: Path, sample_summary: Path, out: Path) -> dict:
+    """Write ``metrics.json`` for the room type."""
+    import torch
+
+    from ..corpus.procedural_rules import satisfaction
+    from ..learn import graph_data, graph_metrics as gm
+    from .train_graph_model import room_graphs
+
+    saved = torch.load(model, map_location="cpu", weights_only=False)
+    vocab = graph_data.Vocab(tuple(saved["categories"]))
+    _, real = room_graphs(nodes, edges, room_type)
+    by_id = {g.room_id: g for g in real}
+    train = [by_id[i] for i in saved["train_ids"] if i in by_id]
+    held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
+    gen = graph_data.graphs_from_tables(tables.read(gen_nodes, "generated_nodes").to_pandas(),
+                                        tables.read(gen_edges, "generated_edges").to_pandas(), vocab)
+    rng = np.random.default_rng([config["seed"], 99])
+    floor_set = [train[i] for i in rng.permutation(len(train))[:min(len(gen), len(train))]]
+    classes = range(len(vocab.node_classes))
+    got, floor = gm.distances(held, gen, classes), gm.distances(held, floor_set, classes)
+    hist = pd.read_csv(history)
+    best = hist.loc[hist["heldout_nll"].idxmin()]
+    out_ = {
+        "room_type": room_type, "graphs": {"train": len(train), "heldout": len(held), "generated": len(gen),
+                                           "floor_sample": len(floor_set)},
+        "heldout_nll": {"per_graph": round(float(best["heldout_nll"]), 4),
+                        **{k: round(float(best[f"heldout_{k}"]), 4) for k in ("add_node", "attributes", "add_edge")}},
+        "generated_vs_heldout": _rounded(got), "floor_real_vs_heldout": _rounded(floor),
+        "ratio_to_floor": {k: round(got[k] / floor[k], 3) if floor[k] > 0 else None for k in got},
+        "structures": {"generated": gm.structure_counts(gen), "heldout": gm.structure_counts(held)},
+        "valid_before_rejection": json.loads(Path(sample_summary).read_text())["valid_before_rejection"],
+        **gm.novelty_uniqueness(gen, train),
+        "heldout_novelty": gm.novelty_uniqueness(held, train)["novelty"],
+    }
+    if config["source"] == "procedural":
+        out_["rules"] = {"generated": satisfaction([_rule_view(g, vocab) for g in gen]),
+                         "real": satisfaction([_rule_view(g, vocab) for g in real])}
+    out_["goals"] = _goals(out_)
+    tables.write_json(out, out_)
+    log.info("%s: %s", room_type, out_["goals"])
+    return out_
+
+
+def _rounded(d: dict) -> dict:
+    return {k: round(v, 5) for k, v in d.items()}
+
+
+def _goals(m: dict) -> dict:
+    """The issue's quality goals, met or not (reported, never tuned against)."""
+    r = m["ratio_to_floor"]
+    goals = {f"{k}_within_{FLOOR_FACTOR}x_floor": (r[k] is not None and r[k] <= FLOOR_FACTOR)
+             for k in ("category_kl", "edge_type_kl", "node_count_tv")}
+    goals["valid_before_rejection_at_least_0.8"] = m["valid_before_rejection"] >= 0.8
+    goals["novelty_at_least_0.5"] = m["novelty"] >= 0.5
+    if "rules" in m:
+        gaps = [abs(g["share"] - m["rules"]["real"][k]["share"]) for k, g in m["rules"]["generated"].items()
+                if g["share"] is not None and m["rules"]["real"][k]["share"] is not None]
+        goals["rules_within_5_points"] = bool(gaps) and max(gaps) <= 0.05
+    return goals

@@ -1,0 +1,78 @@
+# The graph generative model (PlanIT section 5), one per room type: train on the final graphs of the ingested
+# corpus, sample graphs in held-out rooms' architectures, evaluate them against the held-out graphs.
+
+
+rule train_graph_model:
+    input:
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+    output:
+        model=GRAPH_MODEL.replace("{name}", "model.pt"),
+        history=GRAPH_MODEL.replace("{name}", "history.csv"),
+        curve=GRAPH_MODEL.replace("{name}", "loss.png"),
+        summary=GRAPH_MODEL.replace("{name}", "training.json"),
+    params:
+        config=keys("seed", *(f"graph_model.{k}" for k in GRAPH_TRAIN_KEYS)),
+    threads: config["graph_model"]["threads"]
+    resources:
+        gpu=1 if config["graph_model"]["device"] == "cuda" else 0,
+    log:
+        "logs/train_graph_model/{room_type}.log",
+    benchmark:
+        "benchmarks/train_graph_model/{room_type}.tsv"
+    conda:
+        ENV
+    shell:
+        "planit train-graph-model --config-json {params.config:q} --room-type {wildcards.room_type} "
+        "--nodes {input.nodes} --edges {input.edges} --out-model {output.model} --out-history {output.history} "
+        "--out-curve {output.curve} --out-summary {output.summary} 2> {log}"
+
+
+rule sample_graphs:
+    input:
+        model=GRAPH_MODEL.replace("{name}", "model.pt"),
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+    output:
+        nodes=GRAPH_MODEL.replace("{name}", "sampled/nodes.parquet"),
+        edges=GRAPH_MODEL.replace("{name}", "sampled/edges.parquet"),
+        summary=GRAPH_MODEL.replace("{name}", "sampled/summary.json"),
+    params:
+        config=keys("seed", "graph_model.sample", "graph_model.threads"),
+    threads: config["graph_model"]["threads"]
+    log:
+        "logs/sample_graphs/{room_type}.log",
+    benchmark:
+        "benchmarks/sample_graphs/{room_type}.tsv"
+    conda:
+        ENV
+    shell:
+        "planit sample-graphs --config-json {params.config:q} --room-type {wildcards.room_type} --model {input.model} "
+        "--nodes {input.nodes} --edges {input.edges} --out-nodes {output.nodes} --out-edges {output.edges} "
+        "--out-summary {output.summary} 2> {log}"
+
+
+rule graph_model_metrics:
+    input:
+        model=GRAPH_MODEL.replace("{name}", "model.pt"),
+        history=GRAPH_MODEL.replace("{name}", "history.csv"),
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+        gen_nodes=GRAPH_MODEL.replace("{name}", "sampled/nodes.parquet"),
+        gen_edges=GRAPH_MODEL.replace("{name}", "sampled/edges.parquet"),
+        sample_summary=GRAPH_MODEL.replace("{name}", "sampled/summary.json"),
+    output:
+        metrics=GRAPH_MODEL.replace("{name}", "metrics.json"),
+    params:
+        config=keys("seed", "source"),
+    log:
+        "logs/graph_model_metrics/{room_type}.log",
+    benchmark:
+        "benchmarks/graph_model_metrics/{room_type}.tsv"
+    conda:
+        ENV
+    shell:
+        "planit graph-model-metrics --config-json {params.config:q} --room-type {wildcards.room_type} "
+        "--model {input.model} --history {input.history} --nodes {input.nodes} --edges {input.edges} "
+        "--gen-nodes {input.gen_nodes} --gen-edges {input.gen_edges} --sample-summary {input.sample_summary} "
+        "--out {output.metrics} 2> {log}"

@@ -1,0 +1,233 @@
+"""The graph generative model (issue: learn and sample relation graphs): tiny preset, CPU, real procedural graphs."""
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from pipeline import config  # noqa: E402
+from pipeline.corpus import procedural_rules  # noqa: E402
+from pipeline.errors import InputError  # noqa: E402
+from pipeline.learn import graph_checks, graph_data, graph_metrics, sampler, spec, train  # noqa: E402
+from pipeline.learn.graph_data import OBJECT_EDGES, Graph  # noqa: E402
+from conftest import ROOT  # noqa: E402
+
+TINY = {**config.validate({})["graph_model"]["presets"]["tiny"]}
+
+
+@pytest.fixture(scope="module")
+def bedrooms(tmp_path_factory):
+    """Final graphs of a few procedural bedrooms, through the real stages (ingest -> ... -> refinement)."""
+    out = tmp_path_factory.mktemp("corpus")
+    cfg = ROOT / "config" / "tiny.yaml"
+    env = {"PATH": f"{Path(sys.executable).parent}:/usr/bin:/bin"}
+    run = subprocess.run([str(Path(sys.executable).parent / "snakemake"), "-s", str(ROOT / "Snakefile"), "-d", str(out),
+                          "--configfile", str(cfg), "--cores", "2", "results/graphs/ingested/edges.parquet"],
+                         capture_output=True, text=True, env=env, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    import pandas as pd
+
+    nodes = pd.read_parquet(out / "results/graphs/ingested/nodes.parquet")
+    edges = pd.read_parquet(out / "results/graphs/ingested/edges.parquet")
+    nodes, edges = nodes[nodes.room_type == "bedroom"], edges[edges.room_type == "bedroom"]
+    vocab = graph_data.vocab_of(nodes)
+    return vocab, graph_data.graphs_from_tables(nodes, edges, vocab)
+
+
+def same_graph(a_classes, a_edges, b: Graph) -> bool:
+    from types import SimpleNamespace
+
+    ga = graph_metrics.to_nx(SimpleNamespace(node_class=a_classes, edges=a_edges))
+    return graph_metrics._same(ga, graph_metrics.to_nx(b))
+
+
+def test_real_graphs_pass_the_validity_checks(bedrooms):
+    _, graphs = bedrooms
+    seen = graph_checks.seen_triples(graphs)
+    assert all(not graph_checks.problems(g.node_class.tolist(), g.role.tolist(), [tuple(e) for e in g.edges.tolist()],
+                                         g.n_arch, seen) for g in graphs)
+
+
+def test_invalid_graphs_are_named():
+    # wall 0; objects 1 (bed), 2 (nightstand), 3 (lamp); classes: 0 wall, 3 bed, 4 nightstand, 5 lamp
+    cls, role = [0, 3, 4, 5], [0, 0, 0, 0]
+    sup, left = OBJECT_EDGES.index("support"), OBJECT_EDGES.index("left/adjacent")
+    wall = OBJECT_EDGES.index("front/adjacent")
+    ok = [(0, 1, wall), (1, 2, left), (2, 3, sup)]
+    seen = {(cls[s], cls[t], c) for s, t, c in ok}
+    assert graph_checks.problems(cls, role, ok, 1, seen) == []
+    assert graph_checks.problems(cls, role, ok[:2], 1, seen) == ["disconnected"]
+    assert "cyclic" in graph_checks.problems(cls, role, ok + [(3, 1, left)], 1, seen | {(5, 3, left)})
+    assert graph_checks.problems(cls, role, ok + [(3, 2, left)], 1, seen) == ["cyclic", "unseen_edge"]
+    chain = graph_checks.ROLES.index("chain")
+    assert graph_checks.problems(cls, [0, chain, 0, 0], ok, 1, seen) == ["inconsistent_chain"]
+
+
+def bed_lamp_graph(real: Graph, vocab) -> Graph:
+    """A real room's architecture holding a bed against wall_1, a nightstand on its left and a lamp on that."""
+    a = real.n_arch
+    inner = (real.edges[:, 0] < a) & (real.edges[:, 1] < a)
+    cls = np.concatenate([real.node_class[:a], [vocab.category_index(c) for c in ("bed", "nightstand", "table_lamp")]])
+    obj = [(real.node_ids.index("wall_1"), a, OBJECT_EDGES.index("front/adjacent")),
+           (a, a + 1, OBJECT_EDGES.index("left/adjacent")), (a + 1, a + 2, OBJECT_EDGES.index("support"))]
+    return Graph("hand", real.node_ids[:a] + ["bed", "nightstand", "lamp"], cls, np.zeros(a + 3, np.int64),
+                 np.zeros(a + 3, np.int64), np.concatenate([real.length[:a], np.zeros(3)]), a,
+                 np.concatenate([real.edges[inner], np.array(obj)]).astype(np.int64), np.concatenate([real.angle[inner], np.zeros(3)]))
+
+
+def test_tiny_model_overfits_a_graph_and_greedy_sampling_reproduces_it(bedrooms, tmp_path):
+    vocab, graphs = bedrooms
+    g = bed_lamp_graph(graphs[0], vocab)
+    run = train.train([g], [g], vocab, {**TINY, "max_epochs": 120, "patience": 120}, 10, 0, tmp_path / "ck.pt", "h")
+    assert run.history[-1]["heldout_nll"] < 0.05 * run.history[0]["heldout_nll"]
+    out = sampler.sample(run.model, vocab, [g], seed=0, temperature=0.0, max_objects=25, max_edges=10)[0]
+    assert same_graph(out.node_class, out.edges, g)
+
+
+def test_resuming_from_a_checkpoint_gives_the_weights_of_an_uninterrupted_run(bedrooms, tmp_path):
+    vocab, graphs = bedrooms
+    tr, held = graphs[:-2], graphs[-2:]
+    whole = train.train(tr, held, vocab, {**TINY, "max_epochs": 4, "patience": 99}, 10, 3, tmp_path / "a.pt", "h")
+    train.train(tr, held, vocab, {**TINY, "max_epochs": 2, "patience": 99}, 10, 3, tmp_path / "b.pt", "h")  # interrupted
+    resumed = train.train(tr, held, vocab, {**TINY, "max_epochs": 4, "patience": 99}, 10, 3, tmp_path / "b.pt", "h")
+    assert resumed.resumed_from == 2 and len(resumed.history) == 4
+    for k, v in whole.model.state_dict().items():
+        assert torch.equal(v, resumed.model.state_dict()[k]), k
+    other = train.train(tr, held, vocab, {**TINY, "max_epochs": 1, "patience": 99}, 10, 3, tmp_path / "b.pt", "other")
+    assert other.resumed_from == 0  # a checkpoint of other settings is not resumed
+
+
+@pytest.fixture(scope="module")
+def model(bedrooms, tmp_path_factory):
+    vocab, graphs = bedrooms
+    run = train.train(graphs[:-1], graphs[-1:], vocab, {**TINY, "max_epochs": 15}, 10, 0,
+                      tmp_path_factory.mktemp("m") / "ck.pt", "h")
+    return run.model
+
+
+def test_sampling_with_a_seed_is_deterministic(bedrooms, model):
+    vocab, graphs = bedrooms
+    runs = [sampler.sample(model, vocab, graphs[:4], seed=s, temperature=1.0, max_objects=25, max_edges=10) for s in (5, 5, 6)]
+    key = lambda gs: [(g.node_class, g.edges) for g in gs]  # noqa: E731
+    assert key(runs[0]) == key(runs[1]) and key(runs[0]) != key(runs[2])
+
+
+def test_sampling_never_proposes_unseen_cyclic_or_second_parent_edges(bedrooms, model):
+    vocab, graphs = bedrooms
+    seen = graph_checks.seen_triples(graphs)
+    out = sampler.sample(model, vocab, graphs * 4, seed=1, temperature=1.5, max_objects=25, max_edges=10, seen=seen)
+    for g in out:
+        reasons = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen)
+        assert "unseen_edge" not in reasons and "cyclic" not in reasons
+        parents = [t for s, t, c in g.edges if c == 0]
+        assert len(parents) == len(set(parents))
+
+
+SPEC = """
+room_type: bedroom
+objects:
+  - bed
+  - side: nightstand
+  - lamp: table_lamp
+relations:
+  side: {left_of: bed, distance: adjacent}
+  lamp: {on_top_of: side}
+"""
+
+
+def test_completion_keeps_every_given_node_and_edge(bedrooms, model, tmp_path):
+    vocab, graphs = bedrooms
+    (tmp_path / "spec.yaml").write_text(SPEC)
+    plan, arch = spec.load_spec(tmp_path / "spec.yaml", "bedroom", vocab)
+    assert arch is None and len(plan.objects) == 3
+    out = sampler.sample(model, vocab, graphs[:5], seed=2, temperature=1.0, max_objects=25, max_edges=10,
+                         plans=[plan] * 5)
+    cls = {c: vocab.category_index(c) for c in ("bed", "nightstand", "table_lamp")}
+    for g in out:
+        bed, side, lamp = (g.arch.n_arch + k for k in range(3))
+        assert [g.node_class[k] for k in (bed, side, lamp)] == [cls["bed"], cls["nightstand"], cls["table_lamp"]]
+        assert (bed, side, OBJECT_EDGES.index("left/adjacent")) in g.edges
+        assert (side, lamp, OBJECT_EDGES.index("support")) in g.edges
+
+
+@pytest.mark.parametrize("body, message", [
+    ("room_type: bedroom\nobjects: [bed, harp]\n", "unknown category 'harp'"),
+    ("room_type: bedroom\nobjects: [bed, nightstand]\nrelations:\n  nightstand: {left_of: bedd}\n", "no object named 'bedd'"),
+    ("room_type: bedroom\nobjects: [bed, nightstand]\nrelations:\n  nightstand: {next_to: bed}\n", "unknown relation 'next_to'"),
+    ("room_type: bedroom\nobjects: [bed]\nrelations:\n  sofa: {left_of: bed}\n", "no object named 'sofa'"),
+    ("room_type: bedroom\nobjects: bed\n", "objects: 'bed' is not of type 'array'"),
+    ("room_type: kitchen\nobjects: [bed]\n", "the model is for 'bedroom'"),
+])
+def test_invalid_specs_name_the_problem(bedrooms, tmp_path, body, message):
+    vocab, _ = bedrooms
+    (tmp_path / "bad.yaml").write_text(body)
+    with pytest.raises(InputError, match=message.replace("(", r"\(")) as err:
+        spec.load_spec(tmp_path / "bad.yaml", "bedroom", vocab)
+    assert "bad.yaml" in str(err.value)
+
+
+def test_example_specs_are_valid():
+    import yaml
+
+    from pipeline.corpus import catalog
+
+    vocab = graph_data.Vocab(tuple(sorted(catalog.CATEGORIES)))  # every category the procedural corpus has
+    files = sorted((ROOT / "config" / "specs").glob("*.yaml"))
+    assert len(files) >= 2
+    for f in files:
+        plan, _ = spec.load_spec(f, yaml.safe_load(f.read_text())["room_type"], vocab)
+        assert plan.objects and plan.edges
+
+
+def test_metrics_separate_equal_and_different_sets(bedrooms):
+    vocab, graphs = bedrooms
+    classes = range(len(vocab.node_classes))
+    same = graph_metrics.distances(graphs, graphs, classes)
+    assert same["category_kl"] < 1e-9 and same["node_count_tv"] == 0 and abs(same["degree_mmd"]) < 1e-9
+    empty = [Graph(g.room_id, g.node_ids[:g.n_arch], g.node_class[:g.n_arch], g.symmetry[:g.n_arch], g.role[:g.n_arch],
+                   g.length[:g.n_arch], g.n_arch, g.edges[(g.edges[:, 0] < g.n_arch) & (g.edges[:, 1] < g.n_arch)],
+                   g.angle[(g.edges[:, 0] < g.n_arch) & (g.edges[:, 1] < g.n_arch)]) for g in graphs]
+    assert graph_metrics.distances(graphs, empty, classes)["node_count_tv"] == pytest.approx(1.0)
+    nu = graph_metrics.novelty_uniqueness(graphs[:3] + graphs[:1], graphs[:2])
+    assert nu["novelty"] == 0.25 and nu["uniqueness"] == 0.75
+
+
+def test_procedural_rules_hold_on_real_graphs(bedrooms):
+    vocab, graphs = bedrooms
+    from pipeline.learn.graph_data import EDGE_CLASSES
+
+    view = [([vocab.node_classes[c] for c in g.node_class], [(s, t, EDGE_CLASSES[c]) for s, t, c in g.edges]) for g in graphs]
+    sat = procedural_rules.satisfaction(view)
+    assert sat["against_wall"]["graphs"] == len(graphs) and sat["against_wall"]["share"] >= 0.8
+    assert sat["small_things_on_surfaces"]["share"] == 1.0
+
+
+def test_extraction_and_refinement_never_import_torch():
+    code = ("import sys; import pipeline.extraction, pipeline.filtering, pipeline.graphs.refine, pipeline.stages.ingest, "
+            "pipeline.stages.extract_graphs, pipeline.stages.refine_graphs, pipeline.cli, pipeline.learn.graph_data, "
+            "pipeline.learn.graph_checks, pipeline.learn.graph_metrics; assert 'torch' not in sys.modules, 'torch'")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+
+
+def test_device_is_chosen_automatically():
+    assert train.pick_device("auto") == ("cuda" if torch.cuda.is_available() else "cpu")
+    assert train.pick_device("cpu") == "cpu"
+
+
+def test_batched_training_matches_one_graph_at_a_time(bedrooms):
+    """The batch is a disjoint union: the NLL of a graph does not depend on the graphs batched with it."""
+    from pipeline.learn.teacher import make_batch, nll
+
+    vocab, graphs = bedrooms
+    torch.manual_seed(0)
+    m = train.build_model(vocab, TINY)
+    rng = np.random.default_rng(0)
+    seqs = [graph_data.sequence(g, rng, 10) for g in graphs[:4]]
+    with torch.no_grad():
+        together = nll(m, make_batch(seqs, vocab))
+        alone = torch.cat([nll(m, make_batch([s], vocab)) for s in seqs])
+    assert torch.allclose(together, alone, atol=1e-4)
