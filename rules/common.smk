@@ -55,7 +55,8 @@ REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
 GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
 # what training reads (sampling settings are not among them: changing them resamples without retraining)
-GRAPH_TRAIN_KEYS = ["room_types", "preset", "presets", "max_edges", "heldout_fraction", "device", "threads"]
+GRAPH_TRAIN_KEYS = ["preset", f"presets.{config['graph_model']['preset']}", "max_edges", "heldout_fraction", "device",
+                    "threads"]
 
 
 def keys(*dotted):

@@ -33,6 +33,9 @@ def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path 
     return proc
 
 
+GRAPH_MODEL_RULES = ("train_graph_model", "sample_graphs", "graph_model_metrics")
+
+
 def planned_jobs(proc: subprocess.CompletedProcess) -> set[str]:
     """Rules a dry run would run (from its 'Job stats' table)."""
     text = proc.stdout + proc.stderr
@@ -116,7 +119,7 @@ def _dry_run_with(run_dir, tmp_path, yaml_text: str) -> set[str]:
 
 def test_a_refinement_threshold_reruns_refinement_and_after_only(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n  thresholds: {proximal: 0.2}\n")
-    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report"}
+    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report", *GRAPH_MODEL_RULES}
 
 
 def test_a_chain_setting_reruns_the_statistics_map_step(run_dir, tmp_path):
@@ -145,7 +148,33 @@ def test_a_filter_threshold_reruns_only_downstream(run_dir, tmp_path):
 
 def test_forcerun_refine_reruns_only_refinement_and_after(run_dir):
     jobs = planned_jobs(snakemake(run_dir, "--dry-run", "--forcerun", "refine_graphs"))
-    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report"}
+    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report", *GRAPH_MODEL_RULES}
+
+
+def test_a_sampling_setting_resamples_without_retraining(run_dir, tmp_path):
+    jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n"
+                                            "graph_model:\n  sample: {graphs: 20, batch_size: 20, temperature: 0.8}\n")
+    assert jobs == {"sample_graphs", "graph_model_metrics"}
+
+
+def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
+    res = run_dir / "results" / "graph_model"
+    for room_type in ("bedroom", "living", "office", "bathroom", "kitchen"):
+        folder = res / room_type
+        training = json.loads((folder / "training.json").read_text())
+        assert training["epochs"] >= 1 and training["device"] == "cpu"
+        assert (folder / "loss.png").stat().st_size > 1000
+        assert pd.read_csv(folder / "history.csv")["heldout_nll"].notna().all()
+        for name, table in (("nodes", "generated_nodes"), ("edges", "generated_edges")):
+            schema = pq.read_schema(folder / "sampled" / f"{name}.parquet")
+            assert schema.remove_metadata().equals(tables.SCHEMAS[table].remove_metadata())
+        summary = json.loads((folder / "sampled" / "summary.json").read_text())
+        nodes = pd.read_parquet(folder / "sampled" / "nodes.parquet")
+        assert nodes.scene_id.nunique() == summary["written"] and summary["written"] + summary["failed_after_budget"] == 20
+        metrics = json.loads((folder / "metrics.json").read_text())
+        assert {"heldout_nll", "generated_vs_heldout", "floor_real_vs_heldout", "novelty", "uniqueness", "rules",
+                "goals"} <= set(metrics)
+        assert (run_dir / "logs" / "train_graph_model" / f"{room_type}.log").stat().st_size > 0
 
 
 def test_invalid_config_names_the_key_in_one_line(tmp_path):

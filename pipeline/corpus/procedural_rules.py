@@ -13,7 +13,8 @@ from typing import Callable
 SURFACES = {"nightstand", "side_table", "dresser", "sideboard", "desk", "vanity", "kitchen_cabinet", "cabinet",
             "tv_stand", "dining_table", "round_table", "meeting_table"}
 AGAINST_WALL = {"bed", "wardrobe", "toilet", "refrigerator", "kitchen_cabinet", "stove", "sink_cabinet", "dishwasher",
-                "tv_stand", "vanity"}
+                "tv_stand", "vanity", "desk", "dresser", "sideboard", "pantry", "bathtub", "shower", "washing_machine",
+                "dryer"}
 
 
 def _near_wall(cats, edges, k) -> bool:
@@ -29,7 +30,8 @@ def _linked(edges, a, b, kinds=None) -> bool:
 
 
 def against_wall(cats, edges) -> bool | None:
-    """Beds, wardrobes, toilets, kitchen units, TV stands and vanities stand against a wall (wall -> it, adjacent)."""
+    """Beds, wardrobes, desks, dressers, toilets, baths, kitchen and laundry units, TV stands and vanities stand against
+    a wall (wall -> it, adjacent)."""
     ks = [k for k, c in enumerate(cats) if c in AGAINST_WALL]
     return all(_near_wall(cats, edges, k) for k in ks) if ks else None
 

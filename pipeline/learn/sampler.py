@@ -116,7 +116,8 @@ def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, tempe
            max_edges: int, plans: list[Plan] | None = None, seen: set | None = None) -> list[Grown]:
     """One graph per architecture in ``archs`` (only their architecture is used), grown in one batch. With ``seen``
     (anchor class, target class, type) triples, edges of unseen kinds are never proposed; edges that would close a
-    cycle among objects or give an object a second support parent never are."""
+    cycle among objects or give an object a second support parent never are, and every new object takes at least one
+    edge when it can (as in training, where each object touches a node before it)."""
     gen = torch.Generator().manual_seed(int(seed))
     st = _State(model, archs, vocab, allowed_tensor(seen, len(vocab.node_classes)) if seen is not None else None)
     plans = plans or [Plan() for _ in archs]
@@ -162,6 +163,9 @@ def _edges(st: _State, graphs: torch.Tensor, plans: list[Plan], n_objects: list[
     for step in range(max_edges + 1):
         logits = model.decide_edges(base, stop, chosen)
         logits[:, :-1] = logits[:, :-1].masked_fill(_order_mask(st, graphs, width).reshape(len(graphs), -1), float("-inf"))
+        if step == 0:  # every object joins the graph (training orders are connected): no stop before one edge
+            can = torch.isfinite(logits[:, :-1]).any(1)
+            logits[:, -1] = torch.where(can, torch.full_like(logits[:, -1], float("-inf")), logits[:, -1])
         pick = _pick(logits, temperature, gen).tolist()
         for r, b in enumerate(graphs.tolist()):
             if not open_[r]:

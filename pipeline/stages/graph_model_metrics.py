@@ -45,7 +45,8 @@ def run(config: dict, room_type: str, model: Path, history: Path, nodes: Path, e
     rng = np.random.default_rng([config["seed"], 99])
     floor_set = [train[i] for i in rng.permutation(len(train))[:min(len(gen), len(train))]]
     classes = range(len(vocab.node_classes))
-    got, floor = gm.distances(held, gen, classes), gm.distances(held, floor_set, classes)
+    floor = gm.distances(held, floor_set, classes)
+    got = gm.distances(held, gen, classes) if gen else {k: None for k in floor}  # nothing valid was sampled
     hist = pd.read_csv(history)
     best = hist.loc[hist["heldout_nll"].idxmin()]
     out_ = {
@@ -54,7 +55,7 @@ def run(config: dict, room_type: str, model: Path, history: Path, nodes: Path, e
         "heldout_nll": {"per_graph": round(float(best["heldout_nll"]), 4),
                         **{k: round(float(best[f"heldout_{k}"]), 4) for k in ("add_node", "attributes", "add_edge")}},
         "generated_vs_heldout": _rounded(got), "floor_real_vs_heldout": _rounded(floor),
-        "ratio_to_floor": {k: round(got[k] / floor[k], 3) if floor[k] > 0 else None for k in got},
+        "ratio_to_floor": {k: round(got[k] / floor[k], 3) if got[k] is not None and floor[k] > 0 else None for k in got},
         "structures": {"generated": gm.structure_counts(gen), "heldout": gm.structure_counts(held)},
         "valid_before_rejection": json.loads(Path(sample_summary).read_text())["valid_before_rejection"],
         **gm.novelty_uniqueness(gen, train),
@@ -70,7 +71,7 @@ def run(config: dict, room_type: str, model: Path, history: Path, nodes: Path, e
 
 
 def _rounded(d: dict) -> dict:
-    return {k: round(v, 5) for k, v in d.items()}
+    return {k: None if v is None else round(v, 5) for k, v in d.items()}
 
 
 def _goals(m: dict) -> dict:

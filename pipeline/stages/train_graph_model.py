@@ -43,8 +43,8 @@ def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path,
     by_id = {g.room_id: g for g in graphs}
     train_g, held_g = [by_id[i] for i in train_ids], [by_id[i] for i in held_ids]
     device = train.pick_device(gm["device"])
-    chash = config_hash({"graph_model": {k: v for k, v in gm.items() if k != "sample"}, "seed": config["seed"],
-                         "room_type": room_type, "graphs": sorted(by_id)})
+    chash = config_hash({"preset": preset, "max_edges": gm["max_edges"], "heldout_fraction": gm["heldout_fraction"],
+                         "seed": config["seed"], "room_type": room_type, "graphs": sorted(by_id)})
     bar = iter(progress(range(preset["max_epochs"]), desc=f"train {room_type} (max {preset['max_epochs']} epochs)"))
 
     def tick(epoch, row):
