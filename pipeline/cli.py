@@ -231,12 +231,13 @@ def train_graph_model(config: Optional[Path] = ConfigOpt, config_json: Optional[
                       edges: Path = _file("--edges", "final edges"), out_model: Path = _file("--out-model"),
                       out_history: Path = _file("--out-history", "loss per epoch (CSV)"),
                       out_curve: Path = _file("--out-curve", "loss curves (PNG)"),
-                      out_summary: Path = _file("--out-summary", "training summary (JSON)")) -> None:
+                      out_summary: Path = _file("--out-summary", "training summary (JSON)"),
+                      threads: int = typer.Option(1, "--threads", help="CPU threads (the rule's threads)")) -> None:
     """Train the graph generative model of one room type (resumes from the checkpoint beside --out-model)."""
     from .stages import train_graph_model as stage
 
     _summary(_stage(stage.run, config, config_json, room_type, nodes, edges, out_model, out_history, out_curve,
-                    out_summary), skip=("preset",))
+                    out_summary, threads), skip=("preset",))
 
 
 @app.command("sample-graphs")
@@ -249,7 +250,8 @@ def sample_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str]
                   n: Optional[int] = typer.Option(None, "-n", "--count", help="graphs (default graph_model.sample.graphs)"),
                   out_nodes: Optional[Path] = typer.Option(None, "--out-nodes"),
                   out_edges: Optional[Path] = typer.Option(None, "--out-edges"),
-                  out_summary: Optional[Path] = typer.Option(None, "--out-summary")) -> None:
+                  out_summary: Optional[Path] = typer.Option(None, "--out-summary"),
+                  threads: int = typer.Option(1, "--threads", help="CPU threads")) -> None:
     """Sample relation graphs of a room type, from scratch or completing --spec; writes generated_{nodes,edges}."""
     from .stages import sample_graphs as stage
 
@@ -260,7 +262,7 @@ def sample_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str]
     folder = Path("results/graph_model") / room_type / ("completed" if spec else "sampled")
     model = model or Path("results/graph_model") / room_type / "model.pt"
     _summary(_stage(stage.run, config, config_json, room_type, model, nodes, edges, out_nodes or folder / "nodes.parquet",
-                    out_edges or folder / "edges.parquet", out_summary or folder / "summary.json", spec, n),
+                    out_edges or folder / "edges.parquet", out_summary or folder / "summary.json", spec, n, threads),
              skip=("rejections",))
 
 

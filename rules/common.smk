@@ -55,8 +55,7 @@ REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
 GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
 # what training reads (sampling settings are not among them: changing them resamples without retraining)
-GRAPH_TRAIN_KEYS = ["preset", f"presets.{config['graph_model']['preset']}", "max_edges", "heldout_fraction", "device",
-                    "threads"]
+GRAPH_TRAIN_KEYS = ["preset", f"presets.{config['graph_model']['preset']}", "max_edges", "heldout_fraction", "device"]
 
 
 def keys(*dotted):
@@ -104,8 +103,13 @@ def get_corpus_ground_truth(wildcards):
 
 
 def graph_room_types():
-    """Room types with a graph model: graph_model.room_types, else every type the filter knows."""
-    return config["graph_model"]["room_types"] or list(config["filter"]["min_floor_objects"])
+    """Room types with a graph model: graph_model.room_types; else, for the procedural corpus, the types it builds
+    rooms of; else every type the filter knows."""
+    if config["graph_model"]["room_types"]:
+        return config["graph_model"]["room_types"]
+    if config["source"] == "procedural":
+        return [t for t, n in config["procedural"]["rooms"].items() if n > 0]
+    return list(config["filter"]["min_floor_objects"])
 
 
 def get_final_outputs():

@@ -13,7 +13,7 @@ rule train_graph_model:
         summary=GRAPH_MODEL.replace("{name}", "training.json"),
     params:
         config=keys("seed", *(f"graph_model.{k}" for k in GRAPH_TRAIN_KEYS)),
-    threads: config["graph_model"]["threads"]
+    threads: 1  # more per job: set-threads in a profile
     resources:
         gpu=1 if config["graph_model"]["device"] == "cuda" else 0,
     log:
@@ -23,7 +23,7 @@ rule train_graph_model:
     conda:
         ENV
     shell:
-        "planit train-graph-model --config-json {params.config:q} --room-type {wildcards.room_type} "
+        "planit train-graph-model --config-json {params.config:q} --room-type {wildcards.room_type} --threads {threads} "
         "--nodes {input.nodes} --edges {input.edges} --out-model {output.model} --out-history {output.history} "
         "--out-curve {output.curve} --out-summary {output.summary} 2> {log}"
 
@@ -38,8 +38,8 @@ rule sample_graphs:
         edges=GRAPH_MODEL.replace("{name}", "sampled/edges.parquet"),
         summary=GRAPH_MODEL.replace("{name}", "sampled/summary.json"),
     params:
-        config=keys("seed", "graph_model.sample", "graph_model.threads"),
-    threads: config["graph_model"]["threads"]
+        config=keys("seed", "graph_model.sample"),
+    threads: 1
     log:
         "logs/sample_graphs/{room_type}.log",
     benchmark:
@@ -47,7 +47,8 @@ rule sample_graphs:
     conda:
         ENV
     shell:
-        "planit sample-graphs --config-json {params.config:q} --room-type {wildcards.room_type} --model {input.model} "
+        "planit sample-graphs --config-json {params.config:q} --room-type {wildcards.room_type} --threads {threads} "
+        "--model {input.model} "
         "--nodes {input.nodes} --edges {input.edges} --out-nodes {output.nodes} --out-edges {output.edges} "
         "--out-summary {output.summary} 2> {log}"
 

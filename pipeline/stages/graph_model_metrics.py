@@ -43,7 +43,7 @@ def run(config: dict, room_type: str, model: Path, history: Path, nodes: Path, e
     gen = graph_data.graphs_from_tables(tables.read(gen_nodes, "generated_nodes").to_pandas(),
                                         tables.read(gen_edges, "generated_edges").to_pandas(), vocab)
     rng = np.random.default_rng([config["seed"], 99])
-    floor_set = [train[i] for i in rng.permutation(len(train))[:min(len(gen), len(train))]]
+    floor_set = [train[i] for i in rng.permutation(len(train))[:min(len(gen) or len(train), len(train))]]
     classes = range(len(vocab.node_classes))
     floor = gm.distances(held, floor_set, classes)
     got = gm.distances(held, gen, classes) if gen else {k: None for k in floor}  # nothing valid was sampled

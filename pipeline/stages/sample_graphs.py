@@ -47,7 +47,7 @@ def load_model(path: Path):
 
 
 def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out_nodes: Path, out_edges: Path,
-        out_summary: Path, spec: Path | None = None, count: int | None = None) -> dict:
+        out_summary: Path, spec: Path | None = None, count: int | None = None, threads: int = 1) -> dict:
     """Write ``count`` (default ``graph_model.sample.graphs``) valid graphs and a summary of the sampling."""
     import torch
 
@@ -57,7 +57,7 @@ def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out
     from ..learn.spec import load_spec
 
     sc = config["graph_model"]["sample"]
-    torch.set_num_threads(config["graph_model"]["threads"])
+    torch.set_num_threads(threads)
     saved, vocab, net = load_model(model)
     _, graphs = room_graphs(nodes, edges, room_type)
     by_id = {g.room_id: g for g in graphs}

@@ -26,7 +26,7 @@ def room_graphs(nodes: Path, edges: Path, room_type: str):
 
 
 def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path, out_history: Path, out_curve: Path,
-        out_summary: Path) -> dict:
+        out_summary: Path, threads: int = 1) -> dict:
     """Train, write the best weights (with vocabulary, split and seen edge types), the loss curves and a summary.
     The checkpoint beside ``out_model`` resumes an interrupted run with the same settings."""
     import torch
@@ -35,7 +35,7 @@ def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path,
 
     gm = config["graph_model"]
     preset = gm["presets"][gm["preset"]]
-    torch.set_num_threads(gm["threads"])
+    torch.set_num_threads(threads)
     vocab, graphs = room_graphs(nodes, edges, room_type)
     train_ids, held_ids = graph_data.split_heldout([g.room_id for g in graphs], gm["heldout_fraction"], config["seed"])
     if not train_ids or not held_ids:
