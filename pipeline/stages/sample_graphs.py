@@ -51,9 +51,6 @@ def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out
     """Write ``count`` (default ``graph_model.sample.graphs``) valid graphs and a summary of the sampling."""
     import torch
 
-    from ..learn import graph_checks, graph_data
-    from ..learn.graph_tables import grown_rows
-    from ..learn.sampler import sample
     from ..learn.spec import load_spec
 
     sc = config["graph_model"]["sample"]
@@ -62,36 +59,68 @@ def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out
     _, graphs = room_graphs(nodes, edges, room_type)
     by_id = {g.room_id: g for g in graphs}
     held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
-    plan, arch_from = (None, None)
+    seen = {tuple(t) for t in saved["seen"]}
+    plan = None
     if spec is not None:
         plan, arch_from = load_spec(spec, room_type, vocab)
+        if arch_from and arch_from not in by_id:
+            raise InputError(f"{spec}: architecture.room: no room '{arch_from}' of type {room_type} in {nodes}")
         held = [by_id[arch_from]] if arch_from else held
+        seen |= _plan_triples(plan)  # what the spec asks for is allowed, seen in training or not
     if not held:
         raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
     n = count or sc["graphs"]
-    seen = {tuple(t) for t in saved["seen"]}
-    node_df = tables.read(nodes, "final_nodes", filters=[("room_type", "=", room_type)]).to_pandas()
-    edge_df = tables.read(edges, "final_edges", filters=[("room_type", "=", room_type)]).to_pandas()
-    arch_rows = _architecture_rows(node_df, edge_df)
     base_seed = zlib.crc32(f"{config['seed']}/{room_type}/{spec or ''}".encode())
-    kept, first_try, reasons = {}, Counter(), Counter()
+    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, saved["max_edges"], room_type)
+    _write(kept, vocab, nodes, edges, room_type, out_nodes, out_edges)
+    summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": n - len(kept),
+               "valid_before_rejection": round(first_try / max(n, 1), 4), "rejections": dict(reasons),
+               "temperature": sc["temperature"], "spec": str(spec) if spec else None}
+    tables.write_json(out_summary, summary)
+    log.info("%s", summary)
+    return summary
+
+
+def _plan_triples(plan) -> set[tuple[int, int, int]]:
+    from ..learn.graph_data import ARCH
+
+    cls = [len(ARCH) + c for c, _, _ in plan.objects]
+    return {(cls[k], cls[j], c) if d == 0 else (cls[j], cls[k], c) for k, d, c, j in plan.edges}
+
+
+def _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, max_edges, room_type) -> tuple[dict, int, Counter]:
+    """Graph index -> (valid graph, seed); how many were valid at the first try; rejections by reason. A graph that
+    fails the checks is sampled again, up to ``resample_budget`` times."""
+    from ..learn import graph_checks
+    from ..learn.sampler import sample
+
+    kept, first_try, reasons = {}, 0, Counter()
     pending = list(range(n))
     for attempt in range(sc["resample_budget"] + 1):
         for k in progress(range(0, len(pending), sc["batch_size"]), desc=f"sample {room_type}, try {attempt + 1}"):
             part = pending[k:k + sc["batch_size"]]
             seed = base_seed + 1_000_003 * attempt + k
             grown = sample(net, vocab, [held[i % len(held)] for i in part], seed, sc["temperature"], sc["max_objects"],
-                           saved["max_edges"], [plan] * len(part) if plan else None, seen)
+                           max_edges, [plan] * len(part) if plan else None, seen)
             for i, g in zip(part, grown):
                 bad = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen)
                 reasons.update(bad)
-                if attempt == 0:
-                    first_try["valid" if not bad else "invalid"] += 1
+                first_try += attempt == 0 and not bad
                 if not bad:
                     kept[i] = (g, seed)
         pending = [i for i in pending if i not in kept]
         if not pending:
             break
+    return kept, first_try, reasons
+
+
+def _write(kept: dict, vocab, nodes: Path, edges: Path, room_type: str, out_nodes: Path, out_edges: Path) -> None:
+    """The kept graphs as generated_nodes / generated_edges rows, architecture copied from their rooms."""
+    from ..learn.graph_tables import grown_rows
+
+    flt = [("room_type", "=", room_type)]
+    arch_rows = _architecture_rows(tables.read(nodes, "final_nodes", filters=flt).to_pandas(),
+                                   tables.read(edges, "final_edges", filters=flt).to_pandas())
     rows_n, rows_e = [], []
     for i in sorted(kept):
         g, seed = kept[i]
@@ -101,12 +130,6 @@ def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out
         rows_e += ee
     tables.write(out_nodes, "generated_nodes", tables.from_rows("generated_nodes", rows_n))
     tables.write(out_edges, "generated_edges", tables.from_rows("generated_edges", rows_e))
-    summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": len(pending),
-               "valid_before_rejection": round(first_try["valid"] / max(sum(first_try.values()), 1), 4),
-               "rejections": dict(reasons), "temperature": sc["temperature"], "spec": str(spec) if spec else None}
-    tables.write_json(out_summary, summary)
-    log.info("%s", summary)
-    return summary
 
 
 def _architecture_rows(node_df, edge_df) -> dict:
