@@ -7,6 +7,7 @@ scales the logits (0: always the most likely choice).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,12 +39,19 @@ class Grown:
     edges: list[tuple[int, int, int]]
 
 
-def allowed_tensor(seen: set, classes: int) -> torch.Tensor:
-    """``(classes, classes, 13)`` bool from (anchor class, target class, type) triples."""
+@functools.lru_cache(maxsize=8)
+def _allowed(seen: frozenset, classes: int) -> torch.Tensor:
     out = torch.zeros(classes, classes, N_OBJECT_EDGES, dtype=torch.bool)
-    for a, t, c in seen:
-        out[a, t, c] = True
+    if seen:
+        idx = torch.tensor(sorted(seen))
+        out[idx[:, 0], idx[:, 1], idx[:, 2]] = True
     return out
+
+
+def allowed_tensor(seen: set, classes: int) -> torch.Tensor:
+    """``(classes, classes, 13)`` bool from (anchor class, target class, type) triples (cached: sampling calls it
+    once per batch with the same set)."""
+    return _allowed(frozenset(seen), classes)
 
 
 def _pick(logits: torch.Tensor, temperature: float, gen: torch.Generator) -> torch.Tensor:
