@@ -182,7 +182,8 @@ def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: fl
         & (scene.up[face] | ~relations.inside_boxes(s_orig[r], b[own])), max_dist=reach)
     footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
     if sc["inside_box_contact"]:
-        _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, sc["start_offset"], boxy, sc["box_top_tolerance"])
+        _box_contacts(b, footprint, s_orig, s_obj, first_owner, first_dist, reach, sc["start_offset"], boxy,
+                      sc["box_top_tolerance"])
     parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
     if sc["inside_box_contact"] and len(raised):  # raised box, nothing below: held from around (hung in a slab)?
         loose = raised[(parent[raised] < 0) & boxy[raised]]
@@ -194,12 +195,12 @@ def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: fl
     return parent, area, len(s_orig), len(cycles)
 
 
-def _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, start_offset, boxy, top_tolerance) -> None:
+def _box_contacts(b, footprint, s_orig, s_obj, first_owner, first_dist, reach, start_offset, boxy, top_tolerance) -> None:
     """Box-only sources: a grid point whose ray finds nothing within reach but lies in another object's box rests
     on the box whose top is level with the object's bottom (within ``top_tolerance``), else on the widest box
     around it (boxes reach above their support surface: cushions on beds, things in fridges, a desk's hutch; a
     chair tucked under the desk rises above the desk top the bowl stands on). The point just below the object's
-    bottom is tested too (a top level with the bottom hides behind the bottom face). Updates ``first_owner`` /
+    bottom is tested too (a top level with the bottom hides behind the bottom face); ``footprint (n,)`` m^2. Updates ``first_owner`` /
     ``first_dist`` in place."""
     volume = np.prod(2 * b[:, 3:6], axis=1)
     miss = np.flatnonzero((first_dist > reach) & boxy[s_obj])
@@ -211,7 +212,6 @@ def _box_contacts(b, s_orig, s_obj, first_owner, first_dist, reach, start_offset
     bottom = origin[:, 2] - start_offset
     top = b[:, 2] + b[:, 5]
     off = np.abs(top[None, :] - bottom[:, None])
-    footprint = 4 * b[:, 3] * b[:, 4]
     # a box whose top is level with the bottom is the surface itself; otherwise the point is inside furniture
     # (a desk with its hutch, a chair tucked under it): the widest box around it holds it
     score = np.where(off <= top_tolerance, off, 10.0 - footprint[None, :] / max(footprint.max(), 1e-12))

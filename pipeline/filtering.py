@@ -124,7 +124,7 @@ def filter_rooms(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.Da
               "boxes": objs[["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]].to_numpy(float),
               "parents": objs["source_parent_id"].astype(object).to_numpy(),
               "poses": objs[["px", "py", "pz", "yaw", "sx", "sy", "sz"]].to_numpy(float),
-              "meshes": np.array([meshes.get(m) for m in objs["model_id"].astype(object)] + [None], dtype=object)[:-1]}
+              "meshes": [meshes.get(m) for m in objs["model_id"].astype(object)]}  # a list: sliced per room like the arrays
     empty = slice(0, 0)
     rows = []
     for room in rooms.itertuples(index=False):

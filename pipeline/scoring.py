@@ -23,8 +23,8 @@ def extraction_counts(nodes: pd.DataFrame, edges: pd.DataFrame, gt: pd.DataFrame
     found = pairs["distance"].astype(str) == "adjacent"
     same_dir = found & (pairs["got_direction"].astype(str) == pairs["direction"].astype(str))
     case = pairs["label"].astype(object).fillna("unlabelled").astype(str)
-    per_case = {f"{k}:{c}": int(v) for k, col in (("intended", found | True), ("found", found))
-                for c, v in col.groupby(case).sum().items()}
+    per_case = {**{f"intended:{c}": int(v) for c, v in case.value_counts().items()},
+                **{f"found:{c}": int(v) for c, v in found.groupby(case).sum().items()}}
     return Counter({**per_case, "rooms": int(nodes["room_id"].nunique()), "objects": len(merged), "correct": int(correct.sum()),
                     "supported": int(supported.sum()), "correct_supported": int((correct & supported).sum()),
                     "intended": len(pairs), "found": int(found.sum()), "same_dir": int(same_dir.sum()),

@@ -334,7 +334,6 @@ class RoomBuilder:
     def turned(self) -> bool:
         return bool(self.rng.random() < self.placement.get("turned", 0.0))
 
-
     # ------------------------------------------------------------------ functional arrangements
     def bed_with_nightstands(self) -> None:
         bed, ns = self.model("bed"), self.model("nightstand")

@@ -124,15 +124,22 @@ def _graph(room_id: str, g: pd.DataFrame, e: pd.DataFrame, vocab: Vocab) -> Grap
                  arr[:, :3].astype(np.int64), arr[:, 3])
 
 
-def node_features(graph: Graph, vocab: Vocab) -> np.ndarray:
-    """``(n, vocab.feature_size)`` float32: one-hot class, symmetry, role, then the length (m)."""
-    n, c, s = len(graph.node_ids), len(vocab.node_classes), len(SYMMETRIES)
+def features(vocab: Vocab, node_class, symmetry, role, length) -> np.ndarray:
+    """``(n, vocab.feature_size)`` float32 node features from ``(n,)`` arrays: one-hot class, symmetry, role, then
+    the length (m)."""
+    node_class = np.asarray(node_class, np.int64)
+    n, c, s = len(node_class), len(vocab.node_classes), len(SYMMETRIES)
     x = np.zeros((n, vocab.feature_size), np.float32)
-    x[np.arange(n), graph.node_class] = 1
-    x[np.arange(n), c + graph.symmetry] = 1
-    x[np.arange(n), c + s + graph.role] = 1
-    x[:, -1] = graph.length
+    x[np.arange(n), node_class] = 1
+    x[np.arange(n), c + np.asarray(symmetry, np.int64)] = 1
+    x[np.arange(n), c + s + np.asarray(role, np.int64)] = 1
+    x[:, -1] = length
     return x
+
+
+def node_features(graph: Graph, vocab: Vocab) -> np.ndarray:
+    """:func:`features` of every node of a graph."""
+    return features(vocab, graph.node_class, graph.symmetry, graph.role, graph.length)
 
 
 @dataclass

@@ -14,8 +14,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from ..geometry.symmetry import TYPES as SYMMETRIES
-from .graph_data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, node_features
+from .graph_data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, features, node_features
 from .graph_model import EDGE_CHOICES, GraphModel
 from .teacher import candidate_logits, edge_features
 
@@ -99,10 +98,7 @@ class _State:
         g.node_class.append(cls)
         g.symmetry.append(sym)
         g.role.append(role)
-        x = np.zeros((1, self.vocab.feature_size), np.float32)
-        c, s = len(self.vocab.node_classes), len(SYMMETRIES)
-        x[0, cls], x[0, c + sym], x[0, c + s + role] = 1, 1, 1
-        xt = torch.as_tensor(x)
+        xt = torch.as_tensor(features(self.vocab, [cls], [sym], [role], 0.0))
         new = len(self.x)
         self.x = torch.cat([self.x, xt])
         self.graph = torch.cat([self.graph, torch.tensor([b])])
@@ -132,8 +128,8 @@ def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, tempe
     n_objects = [0] * len(archs)
     active = list(range(len(archs)))
     while active:
-        hg = st.propagate(torch.tensor(active))
         act = torch.tensor(active)
+        hg = st.propagate(act)
         cats = _pick(model.add_node(hg[act]), temperature, gen).tolist()
         attrs = _pick(model.attributes(torch.cat([hg[act], F.one_hot(torch.tensor(cats).clamp(max=model.categories - 1),
                                                                       model.categories).float()], 1)), temperature, gen)
