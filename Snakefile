@@ -13,6 +13,7 @@ include: "rules/ingest.smk"
 include: "rules/extract.smk"
 include: "rules/refine.smk"
 include: "rules/graph_model.smk"
+include: "rules/instantiate.smk"
 
 
 rule all:

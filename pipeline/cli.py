@@ -280,6 +280,80 @@ def graph_model_metrics(config: Optional[Path] = ConfigOpt, config_json: Optiona
     typer.echo(json.dumps(result["goals"]))
 
 
+@app.command("train-placement")
+def train_placement(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                    room_type: str = typer.Option(..., "--room-type"),
+                    net: str = typer.Option("cfcn", "--net", help="cfcn (FiLM-conditioned) or fcn (the unconditional ablation)"),
+                    rooms: List[Path] = _files("--rooms"), architecture: List[Path] = _files("--architecture"),
+                    objects: List[Path] = _files("--objects"), nodes: Path = _file("--nodes", "final nodes"),
+                    edges: Path = _file("--edges", "final edges"), out_model: Path = _file("--out-model"),
+                    out_history: Path = _file("--out-history"), out_curve: Path = _file("--out-curve"),
+                    out_summary: Path = _file("--out-summary"),
+                    threads: int = typer.Option(1, "--threads", help="CPU threads (the rule's threads)")) -> None:
+    """Train the location and orientation networks of one room type (resumes from the checkpoint beside --out-model)."""
+    from .stages import train_placement as stage
+
+    if net not in ("cfcn", "fcn"):
+        _fail(f"--net: '{net}' is not one of cfcn, fcn")
+    _summary(_stage(stage.run, config, config_json, room_type, net, rooms, architecture, objects, nodes, edges, out_model,
+                    out_history, out_curve, out_summary, threads))
+
+
+@app.command()
+def instantiate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+                room_type: str = typer.Option(..., "--room-type"),
+                variant: str = typer.Option("planit", "--variant", help="a key of instantiate.variants"),
+                nodes: Path = _file("--nodes", "graphs: generated (sampled) or final nodes"), edges: Path = _file("--edges"),
+                model: Path = _file("--model", "placement networks"), rooms: List[Path] = _files("--rooms"),
+                architecture: List[Path] = _files("--architecture"), objects: List[Path] = _files("--objects"),
+                models: List[Path] = _files("--models"), symmetry: Path = _file("--symmetry"),
+                category_sizes: Path = _file("--category-sizes"), out: Path = _file("--out", "output folder"),
+                n: Optional[int] = typer.Option(None, "-n", "--count", help="scenes (default from instantiate)")) -> None:
+    """Place graphs of one room type into rooms: canonical tables, a record per scene, GLB / PNG / JSON per scene."""
+    from .stages import instantiate as stage
+
+    _summary(_stage(stage.run, config, config_json, room_type, variant, nodes, edges, model, rooms, architecture, objects,
+                    models, symmetry, category_sizes, out, n))
+
+
+@app.command()
+def table3(summary: List[Path] = _files("--summary", "one per variant"), out: Path = _file("--out")) -> None:
+    """Gather the variants' summaries of one room type into PlanIT's Table 3 (CSV)."""
+    from .stages import instantiate as stage
+
+    typer.echo(_guard(stage.table3, summary, out).to_string(index=False))
+
+
+@app.command()
+def generate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+             room_type: Optional[str] = typer.Option(None, "--room-type", help="default: the spec's room_type"),
+             spec: Optional[Path] = typer.Option(None, "--spec", help="complete this partial graph (YAML) first"),
+             n: int = typer.Option(10, "-n", "--count", help="rooms"),
+             out: Optional[Path] = typer.Option(None, "--out", help="default results/generated/<type>/cli (or spec_<name>)")) -> None:
+    """Sample graphs with the trained graph model (from scratch or completing --spec) and place them, end to end to
+    GLB; needs the trained models of `snakemake` (results/graph_model, results/placement)."""
+    from .stages import generate as stage
+    from .stages import sample_graphs
+
+    if room_type is None:
+        if spec is None:
+            _fail("give --room-type or --spec")
+        room_type = _guard(sample_graphs.spec_room_type, spec)
+    folder = out or Path("results/generated") / room_type / (f"spec_{spec.stem}" if spec else "cli")
+    _summary(_stage(stage.generate, config, config_json, room_type, spec, n, folder))
+
+
+@app.command()
+def complete(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+             room: str = typer.Option(..., "--room", help="a kept room of the corpus"),
+             keep: int = typer.Option(3, "--keep", help="objects kept where they are (the first of the placement order)"),
+             out: Optional[Path] = typer.Option(None, "--out", help="default results/generated/<type>/complete_<room>")) -> None:
+    """Keep a real room's first objects and place the rest of its graph around them."""
+    from .stages import generate as stage
+
+    _summary(_stage(stage.complete, config, config_json, room, keep, out))
+
+
 @app.command()
 def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, 'graphs' / a folder of gathered graph tables, "
                                                "or 'graph_model' / a metrics JSON"),

@@ -7,12 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-import shapely
 
 from .geometry import boxes
 from .geometry.collision import mesh_penetration
 from .geometry.meshes import transform
-from .geometry.polygon import wall_loop
+from .geometry.polygon import poke_out, wall_loop
 from .roomdata import room_slices
 
 RULES = ("unknown_room_type", "wall_loop", "room_height", "room_size", "too_few_objects", "too_many_objects",
@@ -68,9 +67,7 @@ def _placement_reasons(room, objs: dict, cfg: dict) -> list[tuple[str, str]]:
     out = []
     b, ids, parents = objs["boxes"], objs["ids"], objs["parents"]
     corners = boxes.footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
-    outline = shapely.Polygon(np.column_stack([room.floor_x, room.floor_y]))
-    pts = shapely.points(corners.reshape(-1, 2))
-    poke = np.where(shapely.covers(outline, pts), 0.0, shapely.distance(outline.exterior, pts)).reshape(-1, 4).max(1)
+    poke = poke_out(np.column_stack([room.floor_x, room.floor_y]), corners.reshape(-1, 2)).reshape(-1, 4).max(1)
     worst = int(np.argmax(poke))
     if poke[worst] > cfg["outside_tolerance"]:
         out.append(("outside_room", f"{ids[worst]} pokes {poke[worst]:.2f} m out of the room"))

@@ -201,6 +201,23 @@ _GENERATED = [_f("scene_id", _STR, doc="generated scene (= room_id)"),
               _f("sample_seed", pa.int64(), doc="seed of the sampling batch")]
 SCHEMAS["generated_nodes"] = pa.schema([*SCHEMAS["final_nodes"], *_GENERATED])
 SCHEMAS["generated_edges"] = pa.schema([*SCHEMAS["final_edges"], *_GENERATED])
+SCHEMAS["generated_objects"] = pa.schema([*SCHEMAS["objects"], _f("scene_id", _STR, doc="generated scene (= room_id)")])
+SCHEMAS["scenes"] = pa.schema([
+    _f("scene_id", _STR, nullable=False), _f("room_type", _CAT), _f("variant", _CAT, doc="instantiate.variants key"),
+    _f("source_room_id", _STR, doc="the room whose architecture (and, for held-out graphs, graph) the scene uses"),
+    _f("status", _CAT, doc="placed | failed"), _f("reason", _STR, doc="why the search failed"),
+    _f("seconds", _F64, "s"), _f("planned_objects", _I32), _f("placed_objects", _I32),
+    _f("insertions", _I32, doc="accepted placements, those undone by backtracking included"),
+    _f("rejections", _I32, doc="candidates that failed a check"), _f("backtracks", _I32),
+    _f("failures", _STR, doc="JSON: rejections per check (outside, overhangs, collides, violates)"),
+    _f("planned_edges", _I32, doc="planned support and spatial edges between placed nodes"),
+    _f("found_edges", _I32, doc="of those, found again exactly by extraction"),
+    _f("consistency", _F64, doc="found_edges / planned_edges"),
+    _f("violation", _F64, doc="mean violation cost of the planned edges (0 found, 0.5 other distance, 1 missing)"),
+    _f("unplanned_edges", _I32, doc="extracted support or spatial edges at an object that the plan lacks"),
+    _f("unplanned_adjacent", _I32, doc="of those, support or adjacent ones"),
+    _f("colliding_objects", _I32, doc="objects penetrating another deeper than instantiate.checks.collision"),
+])
 SCHEMAS["superstructures"] = pa.schema([
     _f("room_id", _STR, nullable=False), _f("room_type", _CAT),
     _f("group_id", _STR, doc="hub_<k> | chain_<k>, unique within the room"),
@@ -247,7 +264,8 @@ SCHEMAS["category_sizes"] = pa.schema([
 # Rows are unique by these columns; the write refuses a duplicate.
 KEYS = {"rooms": ["room_id"], "architecture": ["room_id", "element_id"], "objects": ["room_id", "object_id"],
         "models": ["model_id"], "symmetry": ["model_id"], "nodes": ["room_id", "node_id"],
-        "final_nodes": ["room_id", "node_id"], "filter_report": ["room_id"], "generated_nodes": ["room_id", "node_id"]}
+        "final_nodes": ["room_id", "node_id"], "filter_report": ["room_id"], "generated_objects": ["room_id", "object_id"],
+        "scenes": ["scene_id"], "generated_nodes": ["room_id", "node_id"]}
 # The rule that writes each kind of table: a missing or corrupt one is reported with the rule to rerun.
 PRODUCERS = {"rooms": "ingest or filter_rooms", "architecture": "ingest", "objects": "ingest", "models": "ingest",
              "ground_truth": "ingest", "ingest_report": "ingest or ingest_summary", "drops": "ingest or ingest_summary",
@@ -257,7 +275,7 @@ PRODUCERS = {"rooms": "ingest or filter_rooms", "architecture": "ingest", "objec
              "cooccurrence": "graph_statistics", "relations": "graph_statistics", "hub_patterns": "graph_statistics",
              "category_sizes": "graph_statistics", "final_nodes": "refine_graphs or gather_graphs",
              "final_edges": "refine_graphs or gather_graphs", "generated_nodes": "sample_graphs",
-             "generated_edges": "sample_graphs"}
+             "generated_edges": "sample_graphs", "generated_objects": "instantiate", "scenes": "instantiate"}
 
 
 def _made_by(name: str | None) -> str:

@@ -28,6 +28,8 @@ wildcard_constraints:
     corpus="[a-z][a-z0-9_]*",
     shard="[0-9]+",
     room_type="[a-z][a-z0-9_]*",
+    net="cfcn|fcn",
+    variant="|".join(config["instantiate"]["variants"]),
 
 
 # ------------------------------------------------------------------------------------------- paths
@@ -54,6 +56,13 @@ GATHERED = "results/graphs/{corpus}/{table}.parquet"
 REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
 GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
+PLACEMENT = "results/placement/{room_type}/{net}/{name}"
+GENERATED = "results/generated/{room_type}/{variant}/{name}"
+TABLE3 = "results/generated/{room_type}/table3.csv"
+VARIANTS = config["instantiate"]["variants"]
+TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldout"]
+# what placement training reads
+PLACEMENT_TRAIN_KEYS = ["preset", f"presets.{config['placement']['preset']}", "device"]
 # what training reads (sampling settings are not among them: changing them resamples without retraining)
 GRAPH_TRAIN_KEYS = ["preset", f"presets.{config['graph_model']['preset']}", "max_edges", "heldout_fraction", "device"]
 
@@ -112,9 +121,25 @@ def graph_room_types():
     return list(config["filter"]["min_floor_objects"])
 
 
+def get_instantiate_inputs(wildcards):
+    """A variant's graphs (sampled, or the corpus's final ones) and placement networks (FCN for the unconditional
+    location, else the CFCN)."""
+    spec = VARIANTS[wildcards.variant]
+    if spec["graphs"] == "sampled":
+        graphs = {t: GRAPH_MODEL.format(room_type=wildcards.room_type, name=f"sampled/{t}.parquet") for t in ("nodes", "edges")}
+    else:
+        graphs = {t: GATHERED.format(corpus="ingested", table=t) for t in ("nodes", "edges")}
+    net = "fcn" if spec["location"] == "fcn" else "cfcn"
+    return {**graphs, "model": PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")}
+
+
 def get_final_outputs():
+    types = graph_room_types()
     return [
-        *expand(GRAPH_MODEL, room_type=graph_room_types(), name=["metrics.json", "loss.png"]),
+        *expand(GRAPH_MODEL, room_type=types, name=["metrics.json", "loss.png"]),
+        *expand(PLACEMENT, room_type=types, net="cfcn", name="loss.png"),
+        *expand(GENERATED, room_type=types, variant="planit", name="summary.json"),
+        *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
         FILTER_REPORT,
         INGEST_REPORT,
         DROPS,

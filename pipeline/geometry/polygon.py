@@ -125,3 +125,12 @@ def extents(xy: np.ndarray) -> tuple[float, float]:
     xy = np.asarray(xy, dtype=float)
     span = xy.max(axis=0) - xy.min(axis=0)
     return float(span[0]), float(span[1])
+
+
+def poke_out(outline: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``(n,)`` how far (m) each of ``points (n, 2)`` lies outside the polygon ``outline (k, 2)`` (0 inside)."""
+    import shapely
+
+    poly = shapely.Polygon(outline)
+    pts = shapely.points(np.asarray(points, float).reshape(-1, 2))
+    return np.where(shapely.covers(poly, pts), 0.0, shapely.distance(poly.exterior, pts))

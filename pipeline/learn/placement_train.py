@@ -1,0 +1,89 @@
+"""Training the location and orientation networks together, one batch of fresh examples per step.
+
+Batches come from ``(seed, step)`` alone, so a run resumed from its checkpoint (written atomically every
+``checkpoint_every`` steps, carrying the config hash) continues exactly as an uninterrupted one. Every
+``log_every`` steps the losses on a fixed batch of held-out rooms are logged.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from .. import tables
+from ..placement.layout import View
+from .placement_data import TrainingRoom, batch
+from .placement_nets import LocationNet, OrientationNet, location_loss, orientation_loss
+
+log = logging.getLogger("planit.placement")
+
+
+def views(preset: dict, categories: tuple[str, ...]) -> tuple[View, View]:
+    return (View(preset["size"], preset["mpp"], categories), View(preset["crop_size"], preset["crop_mpp"], categories))
+
+
+def build(preset: dict, categories: tuple[str, ...], film: bool) -> tuple[LocationNet, OrientationNet]:
+    loc_view, ori_view = views(preset, categories)
+    return (LocationNet(loc_view.channels, len(categories), preset["widths"], preset["blocks"], film),
+            OrientationNet(ori_view.channels, len(categories), preset["bins"], preset["crop_widths"]))
+
+
+def _tensors(b: dict, device: str) -> dict:
+    return {k: torch.as_tensor(v, device=device) for k, v in b.items()}
+
+
+def _losses(nets, b: dict, weight: float) -> tuple[torch.Tensor, torch.Tensor]:
+    loc, ori = nets
+    return (location_loss(loc(b["loc"], b["cond"]), b["cat"], b["row"], b["col"], weight),
+            orientation_loss(ori(b["ori"]), b["cat"], b["bins"]))
+
+
+def train(rooms: list[TrainingRoom], held: list[TrainingRoom], categories: tuple[str, ...], preset: dict, film: bool,
+          seed: int, checkpoint: Path, config_hash: str, device: str = "cpu", progress=None):
+    """Train for ``preset['steps']`` steps; returns the two networks (eval mode) and the history rows."""
+    torch.manual_seed(seed)
+    nets = [n.to(device) for n in build(preset, categories, film)]
+    opt = torch.optim.Adam([p for n in nets for p in n.parameters()], lr=preset["lr"])
+    loc_view, ori_view = views(preset, categories)
+    draw = lambda pool, s, step: _tensors(batch(pool, s, step, preset["batch_size"], loc_view, ori_view, preset["bins"]), device)
+    fixed = draw(held or rooms, seed + 1, 0)
+    state = {"step": 0, "history": []}
+    if checkpoint.exists():
+        saved = torch.load(checkpoint, map_location=device, weights_only=False)
+        if saved.get("config_hash") == config_hash:
+            for n, sd in zip(nets, saved["nets"]):
+                n.load_state_dict(sd)
+            opt.load_state_dict(saved["optimizer"])
+            state = saved["state"]
+            log.info("resumed from %s after step %d", checkpoint, state["step"])
+    start, window = time.perf_counter(), []
+    while state["step"] < preset["steps"]:
+        state["step"] += 1
+        for n in nets:
+            n.train()
+        loc_l, ori_l = _losses(nets, draw(rooms, seed, state["step"]), preset["loss_weight"])
+        opt.zero_grad()
+        (loc_l + ori_l).backward()
+        opt.step()
+        window.append((loc_l.item(), ori_l.item()))
+        if state["step"] % preset["log_every"] == 0 or state["step"] == preset["steps"]:
+            for n in nets:
+                n.eval()
+            with torch.no_grad():
+                h_loc, h_ori = _losses(nets, fixed, preset["loss_weight"])
+            row = {"step": state["step"], "location_loss": float(np.mean([w[0] for w in window])),
+                   "orientation_loss": float(np.mean([w[1] for w in window])), "heldout_location_loss": float(h_loc),
+                   "heldout_orientation_loss": float(h_ori), "seconds": time.perf_counter() - start}
+            state["history"].append(row)
+            window = []
+            if progress:
+                progress(state["step"], row)
+        if state["step"] % preset["checkpoint_every"] == 0 or state["step"] == preset["steps"]:
+            tables.write_atomic(checkpoint, lambda tmp: torch.save({"config_hash": config_hash, "nets": [n.state_dict() for n in nets],
+                                                                    "optimizer": opt.state_dict(), "state": state}, tmp))
+    for n in nets:
+        n.eval()
+    return nets, state["history"]

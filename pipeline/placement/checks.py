@@ -1,0 +1,115 @@
+"""Whether a newly placed object may stay: inside the floor, resting on its support, not colliding, and keeping its
+planned relations. Every predicate is the one the rest of the pipeline uses: the filter's outline and
+penetration tests (meshes via Embree) and the extraction itself for the relations, so a placed room's extracted
+graph is comparable with its plan."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+
+from ..extraction import RoomInput, extract_room
+from ..filtering import deepest_penetration
+from ..geometry import boxes
+from ..geometry.polygon import poke_out
+from .plan import PlanEdge
+
+
+@dataclass
+class Verdict:
+    ok: bool
+    reason: str = ""
+    cost: float = 0.0  # violation cost of the object's planned relations, in [0, 1]
+    culprits: set[str] = field(default_factory=set)  # placed objects that caused the failure
+
+
+@dataclass
+class Checker:
+    """What the checks need besides the room: meshes (model id -> (vertices, faces)), box-only models, the model ->
+    symmetry table, the extraction config (the ``extract`` section plus ``floor_contact``), the ray backend class
+    and the ``instantiate.checks`` thresholds."""
+    meshes: dict
+    box_models: set
+    symmetry: dict
+    extract_cfg: dict
+    intersector: type
+    cfg: dict
+
+    def extract(self, room: RoomInput):
+        return extract_room(room, self.meshes.get, lambda c, m: (self.symmetry.get(m, "none"), "table"),
+                            self.extract_cfg, self.intersector, self.box_models)
+
+
+def support_share(child: np.ndarray, parent: np.ndarray) -> float:
+    """Share of the child's footprint over the parent's (boxes ``(7,)``)."""
+    c, p = (shapely.Polygon(boxes.footprint_corners(*b[[0, 1, 3, 4, 6]])[0]) for b in (child, parent))
+    return float(c.intersection(p).area / max(c.area, 1e-12))
+
+
+def collision(room: RoomInput, k: int, related: set[int], checker: Checker) -> tuple[int, float] | None:
+    """The placed object object ``k`` penetrates deepest beyond ``checks.collision`` (meshes where both have one,
+    else boxes), ignoring ``related`` (its support parent and children); None when it collides with none."""
+    depth = np.zeros((len(room.boxes),) * 2)
+    row = boxes.penetration_depths(room.boxes)[k]
+    row[list(related)] = 0.0
+    depth[k], depth[:, k] = row, row
+    objs = {"meshes": [None if m in checker.box_models else checker.meshes.get(m) for m in room.model_ids],
+            "poses": room.poses}
+    cfg = {"penetration": checker.cfg["penetration"], "max_penetration": checker.cfg["collision"],
+           "intersector": checker.intersector}
+    hit = deepest_penetration(depth, objs, cfg)
+    return None if hit is None else (hit[1] if hit[0] == k else hit[0], hit[2])
+
+
+def edge_cost(planned: PlanEdge, found: dict) -> float:
+    """0 when extraction finds the planned edge; 0.5 for a spatial edge found with another distance; else 1."""
+    got = found.get((planned.source, planned.target), [])
+    if planned.edge_type == "support":
+        return 0.0 if any(g[0] == "support" for g in got) else 1.0
+    spatial = [g for g in got if g[0] == "spatial"]
+    if any(g[1] == planned.direction and g[2] == planned.distance for g in spatial):
+        return 0.0
+    return 0.5 if any(g[1] == planned.direction for g in spatial) else 1.0
+
+
+def found_edges(edges: list[dict]) -> dict:
+    """Extracted edge rows by (source, target): lists of (edge_type, direction, distance)."""
+    out: dict = {}
+    for e in edges:
+        out.setdefault((e["source"], e["target"]), []).append((e["edge_type"], e.get("direction"), e.get("distance")))
+    return out
+
+
+def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str]]:
+    """Mean cost of ``planned`` edges (each between the new object and a node already in the room) on the room's
+    extracted graph, and the objects at the other end of the edges not found exactly."""
+    if not planned:
+        return 0.0, set()
+    found = found_edges(checker.extract(room).edges)
+    costs = [edge_cost(e, found) for e in planned]
+    objects = set(room.object_ids)
+    blame = {n for e, c in zip(planned, costs) if c > 0 for n in (e.source, e.target) if n in objects}
+    return float(np.mean(costs)), blame
+
+
+def check(room: RoomInput, k: int, parent: int | None, children: set[int], planned: list[PlanEdge],
+          tolerance: float, checker: Checker) -> Verdict:
+    """Verdict on object ``k`` of ``room`` (cheap tests first). ``tolerance``: the violation cost allowed now; an
+    object may never break all of its relations fully."""
+    me = room.object_ids[k]
+    corners = boxes.footprint_corners(*room.boxes[k, [0, 1, 3, 4, 6]])[0]
+    if parent is None:
+        poke = float(poke_out(room.outline, corners).max())
+        if poke > checker.cfg["outside"]:
+            return Verdict(False, f"outside the floor by {poke:.2f} m")
+    elif support_share(room.boxes[k], room.boxes[parent]) < checker.cfg["min_support"]:
+        return Verdict(False, "overhangs its support", culprits={room.object_ids[parent]})
+    hit = collision(room, k, children | ({parent} if parent is not None else set()), checker)
+    if hit is not None:
+        return Verdict(False, f"collides with {room.object_ids[hit[0]]} by {hit[1]:.3f} m", culprits={room.object_ids[hit[0]]})
+    cost, blame = relation_cost(room, planned, checker)
+    blame.discard(me)
+    if cost > tolerance or (cost >= 1.0 and planned):
+        return Verdict(False, f"violates its relations (cost {cost:.2f})", cost, blame)
+    return Verdict(True, cost=cost)

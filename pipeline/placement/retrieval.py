@@ -1,0 +1,61 @@
+"""Model retrieval: a placed object takes a model, with its scale and size, from an instance of its category in the
+training rooms (the category's empirical size prior; PlanIT retrieves the model closest to predicted extents).
+Symmetry must match the planned node's where the category has such instances."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..extraction import BOX_COLUMNS
+from ..geometry.boxes import rotation
+
+
+@dataclass(frozen=True)
+class Instance:
+    """One model as it stood in a training room: half extents, the box centre relative to the model origin in the
+    object's frame (x, y, z), the scale, and the height of the box bottom above the floor or its support."""
+    model_id: str
+    half: tuple[float, float, float]
+    offset: tuple[float, float, float]
+    scale: tuple[float, float, float]
+    lift: float
+
+
+class Catalog:
+    """Instances per category (and symmetry) of the training rooms' objects."""
+
+    def __init__(self, objects: pd.DataFrame, symmetry: dict[str, str], floor_contact: float = 0.05):
+        self.by_cat: dict[str, list[Instance]] = {}
+        self.sym: dict[str, list[str]] = {}
+        b = objects[BOX_COLUMNS].to_numpy(float)
+        p = objects[["px", "py", "pz"]].to_numpy(float)
+        s = objects[["sx", "sy", "sz"]].to_numpy(float)
+        local = np.einsum("nji,nj->ni", rotation(b[:, 6]), b[:, :2] - p[:, :2])  # R(-yaw) (c - p)
+        bottom = b[:, 2] - b[:, 5]
+        for k, (cat, model) in enumerate(zip(objects["category"].astype(str), objects["model_id"].astype(str))):
+            inst = Instance(model, tuple(b[k, 3:6]), (local[k, 0], local[k, 1], b[k, 2] - p[k, 2]), tuple(s[k]),
+                            float(bottom[k]) if bottom[k] >= floor_contact else 0.0)
+            self.by_cat.setdefault(cat, []).append(inst)
+            self.sym.setdefault(cat, []).append(symmetry.get(model, "none"))
+
+    def pick(self, category: str, symmetry: str, rng: np.random.Generator) -> Instance:
+        """A random instance of the category, of the node's symmetry where the category has one."""
+        if category not in self.by_cat:
+            raise KeyError(f"no training instance of category '{category}'")
+        pool = self.by_cat[category]
+        same = [k for k, s in enumerate(self.sym[category]) if s == symmetry]
+        return pool[int(rng.choice(same))] if same else pool[int(rng.integers(len(pool)))]
+
+
+def place(inst: Instance, x: float, y: float, support: float | None, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+    """Box ``(7,)`` and pose ``(7,)`` (px, py, pz, yaw, sx, sy, sz) of the instance with its box centred on
+    ``(x, y)``, turned to ``yaw``, its bottom on the ``support`` height (m), or for a floor object (None) at the
+    instance's own height above the floor."""
+    hx, hy, hz = inst.half
+    cz = (inst.lift if support is None else support) + hz
+    o = rotation(yaw) @ np.array(inst.offset[:2])
+    box = np.array([x, y, cz, hx, hy, hz, yaw])
+    pose = np.array([x - o[0], y - o[1], cz - inst.offset[2], yaw, *inst.scale])
+    return box, pose

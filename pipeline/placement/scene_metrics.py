@@ -1,0 +1,37 @@
+"""How a placed room compares with its plan: the planned edges its extracted graph holds again (graph
+consistency), the unplanned ones, the violation cost, and the objects that collide. Same predicates as the
+search's checks (:mod:`pipeline.placement.checks`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..extraction import RoomInput
+from .checks import Checker, collision, edge_cost, found_edges
+from .plan import ScenePlan
+
+
+def consistency(plan: ScenePlan, room: RoomInput, walls_ids: list[str], checker: Checker) -> dict:
+    """Counts over the planned edges whose two ends are in the room."""
+    present = set(room.object_ids) | set(walls_ids)
+    edges = checker.extract(room).edges
+    found = found_edges(edges)
+    planned = [e for e in plan.edges if e.source in present and e.target in present]
+    costs = np.array([edge_cost(e, found) for e in planned])
+    pairs = {(e.source, e.target) for e in planned}
+    objects = set(room.object_ids)
+    extra = [e for e in edges if e["edge_type"] in ("support", "spatial") and (e["source"], e["target"]) not in pairs
+             and (e["source"] in objects or e["target"] in objects)]
+    return {"planned_edges": len(planned), "found_edges": int((costs == 0).sum()),
+            "consistency": float((costs == 0).mean()) if len(costs) else 1.0,
+            "violation": float(costs.mean()) if len(costs) else 0.0, "unplanned_edges": len(extra),
+            "unplanned_adjacent": sum(e["edge_type"] == "support" or e.get("distance") == "adjacent" for e in extra)}
+
+
+def colliding_objects(room: RoomInput, parents: dict[str, str | None], checker: Checker) -> int:
+    """Objects that penetrate another (not their support or what they support) deeper than ``checks.collision``."""
+    ids = room.object_ids
+    count = 0
+    for k, o in enumerate(ids):
+        related = {j for j, u in enumerate(ids) if parents.get(u) == o or parents.get(o) == u}
+        count += collision(room, k, related, checker) is not None
+    return count

@@ -1,0 +1,298 @@
+"""Placing a planned graph's objects one at a time with backtracking (PlanIT section 6, Appendix B).
+
+Each object samples a location from the proposer's density (a product over its placed anchors, masked to the
+floor or its support's top, minus squares around the points already rejected), an orientation, and a model; it
+slides flush against the anchors it must be adjacent to, then must pass :func:`~pipeline.placement.checks.check`.
+After its sample budget, the search backtracks to the nearest earlier object that caused one of its failures (or
+the one before it) and that object is placed afresh elsewhere. The relation tolerance stays 0 for the first
+quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``. A scene fails, with its reason,
+when the backtrack or time budget runs out.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from ..extraction import RoomInput, Walls
+from ..geometry import raster
+from ..geometry.boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
+from ..geometry.frames import Frame
+from .checks import Checker, check
+from .layout import add_object, box_frame, wall_frame, with_objects
+from .order import chains
+from .plan import PlanEdge, ScenePlan
+from .retrieval import Catalog, place
+
+log = logging.getLogger("planit.instantiate")
+
+
+@dataclass
+class Anchor:
+    """A placed node with a planned spatial edge to the object being placed."""
+    node: str
+    frame: Frame
+    symmetry: str
+    direction: str
+    distance: str
+    obj: int | None = None  # index among the room's objects
+    wall: int | None = None  # index among the room's walls
+    target_half: tuple[float, float] = (0.0, 0.0)  # half extents (x, y) of the object being placed
+
+
+class Proposer(Protocol):
+    def density(self, room: RoomInput, walls: Walls, category: str, anchors: list[Anchor], points: np.ndarray) -> np.ndarray:
+        """``(m,)`` unnormalised density of the object's centre at ``points (m, 2)``."""
+
+    def orientation(self, room: RoomInput, walls: Walls, category: str, symmetry: str, xy: np.ndarray,
+                    rng: np.random.Generator) -> float:
+        """A yaw (rad) for an object of the category centred at ``xy``."""
+
+
+@dataclass
+class Outcome:
+    """A scene's search: its status, the room it reached, and the counts of PlanIT's Table 3."""
+    ok: bool
+    room: RoomInput
+    reason: str = ""
+    seconds: float = 0.0
+    insertions: int = 0  # accepted placements, the ones undone by backtracking included
+    rejections: int = 0
+    backtracks: int = 0
+    failures: dict = field(default_factory=dict)  # reason kind -> count
+
+
+class Grid:
+    """Candidate centres: cell centres over the room's bounding square at ``mpp``, and those on the floor."""
+
+    def __init__(self, outline: np.ndarray, mpp: float):
+        lo, hi = outline.min(0), outline.max(0)
+        self.mpp = mpp
+        self.size = int(np.ceil((hi - lo).max() / mpp)) + 2
+        self.centre = (lo + hi) / 2
+        xs, ys = raster.pixel_centres(self.size, mpp, self.centre)
+        self.points = np.stack(np.meshgrid(xs, ys), -1).reshape(-1, 2)
+        self.floor = raster.fill_polygon(outline, self.size, mpp, self.centre).reshape(-1)
+
+
+def anchors_of(v: str, plan: ScenePlan, room: RoomInput, walls: Walls, sym: dict[str, str],
+               half: tuple[float, float] = (0.0, 0.0)) -> list[Anchor]:
+    """The placed objects and walls with a planned spatial edge to ``v`` (whose half extents are ``half``)."""
+    obj = {o: k for k, o in enumerate(room.object_ids)}
+    wall = {w: k for k, w in enumerate(walls.ids)}
+    out = []
+    for e in plan.edges:
+        if e.target != v or e.edge_type != "spatial":
+            continue
+        if e.source in obj:
+            k = obj[e.source]
+            out.append(Anchor(e.source, box_frame(room.boxes[k]), sym.get(e.source, "none"), e.direction, e.distance, obj=k, target_half=half))
+        elif e.source in wall:
+            k = wall[e.source]
+            out.append(Anchor(e.source, wall_frame(walls, k), "none", e.direction, e.distance, wall=k, target_half=half))
+    return out
+
+
+def planned_edges(v: str, plan: ScenePlan, present: set[str]) -> list[PlanEdge]:
+    """Planned support and spatial edges between ``v`` and nodes already present (objects or walls)."""
+    return [e for e in plan.edges if (e.target == v and e.source in present) or (e.source == v and e.target in present)]
+
+
+def side_plane(a: Anchor, room: RoomInput) -> tuple[np.ndarray, np.ndarray]:
+    """Point on and outward normal of the anchor's side named by its edge direction (world)."""
+    if a.wall is not None:
+        return np.array(a.frame.origin), rotation(a.frame.yaw) @ SIDE_NORMALS[0]
+    b = room.boxes[a.obj]
+    s = SIDES.index(a.direction)
+    normal = rotation(b[6]) @ SIDE_NORMALS[s]
+    return b[:2] + normal * (b[4] if s < 2 else b[3]), normal
+
+
+def snap(box: np.ndarray, anchors: list[Anchor], room: RoomInput, gaps: dict, reach: float) -> np.ndarray:
+    """Slide ``box (7,)`` along the normal of each anchor side it is planned adjacent or proximal to (walls first)
+    until its footprint's gap to the side lies in ``gaps[distance] = (lo, hi)`` m, when the slide is under
+    ``reach`` m and the box is on the side's outer half-space (or across a wall)."""
+    box = box.copy()
+    for a in sorted((a for a in anchors if a.distance in gaps), key=lambda a: a.wall is None):
+        point, normal = side_plane(a, room)
+        d = float(((footprint_corners(*box[[0, 1, 3, 4, 6]])[0] - point) @ normal).min())
+        lo, hi = gaps[a.distance]
+        want = min(max(d, lo), hi)
+        if abs(want - d) < reach and (a.wall is not None or d > -reach):  # never leave a footprint through a wall
+            box[:2] += normal * (want - d)
+    return box
+
+
+def inside_walls(box: np.ndarray, walls: Walls, gap: float, reach: float) -> np.ndarray:
+    """Push ``box (7,)`` back into the room past every wall whose inner face its footprint crosses by less than
+    ``reach`` m (only corners opposite the wall's own span count, so reflex corners do not push)."""
+    box = box.copy()
+    for _ in range(2):
+        corners = footprint_corners(*box[[0, 1, 3, 4, 6]])[0]
+        rel = corners[None] - walls.a[:, None]  # (w, 4, 2)
+        along = np.einsum("wkj,wj->wk", rel, walls.dir)
+        depth = np.einsum("wkj,wj->wk", rel, walls.normal)
+        inside_span = (along > 0) & (along < walls.length[:, None])
+        worst = np.where(inside_span & (depth < 0) & (depth > -reach), depth, 0.0).min(1)
+        if not (worst < 0).any():
+            break
+        w = int(np.argmin(worst))
+        box[:2] += walls.normal[w] * (gap - worst[w])
+    return box
+
+
+def tolerance(backtracks: int, budget: int) -> float:
+    """Violation cost allowed after ``backtracks`` of ``budget`` (0 for the first quarter, then growing)."""
+    start = budget / 4
+    return 0.0 if backtracks < start else min(1.0, ((backtracks - start) / max(budget - start, 1e-9)) ** 1.5)
+
+
+def _in_box(points: np.ndarray, b: np.ndarray, inset: float = 0.0) -> np.ndarray:
+    """``(m,)`` points inside box ``b``'s footprint shrunk by ``inset`` m (never below a centimetre across)."""
+    local = (points - b[:2]) @ rotation(b[6])
+    return (np.abs(local[:, 0]) <= max(b[3] - inset, 0.01)) & (np.abs(local[:, 1]) <= max(b[4] - inset, 0.01))
+
+
+class Search:
+    """One scene's search state."""
+
+    def __init__(self, plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer,
+                 catalog: Catalog, checker: Checker, cfg: dict, rng: np.random.Generator):
+        self.plan, self.walls, self.order = plan, walls, order
+        self.proposer, self.catalog, self.checker, self.cfg, self.rng = proposer, catalog, checker, cfg, rng
+        self.fixed = len(room.object_ids)  # objects given (completion) are never moved
+        self.room = room
+        self.grid = Grid(room.outline, cfg["grid_mpp"])
+        sn = cfg["snap"]
+        self.gaps = {"adjacent": (sn["gap"], sn["gap"]), "proximal": tuple(sn["proximal"])}
+        self.sym = dict(zip(plan.ids, plan.symmetry)) | {o: "none" for o in room.object_ids if o not in plan.ids}
+        self.rejected: dict[str, list[tuple[float, float]]] = {}
+        self.shared: dict[tuple, object] = {}
+        self.unit = {}
+        self.backtracks = self.rejections = self.insertions = 0
+        self.failures: dict[str, int] = {}
+
+    def model_for(self, k: int):
+        """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's."""
+        cat, key = self.plan.categories[k], ("own", k)
+        if self.plan.role[k] == "spoke":
+            hubs = [e.source for e in self.plan.edges if e.target == self.plan.ids[k] and e.source in self.plan.ids
+                    and "hub" in self.plan.role[self.plan.index(e.source)]]
+            key = ("spoke", hubs[0] if hubs else None, cat)
+        elif k in self.unit:
+            key = ("chain", self.unit[k], cat)
+        if key not in self.shared:
+            self.shared[key] = self.catalog.pick(cat, self.plan.symmetry[k], self.rng)
+        return self.shared[key]
+
+    def occupied(self, grow: float) -> np.ndarray:
+        """``(cells,)`` candidate centres inside a placed floor object's footprint grown by ``grow`` m."""
+        out = np.zeros(len(self.grid.points), bool)
+        b = self.room.boxes
+        for j in np.flatnonzero(b[:, 2] - b[:, 5] < self.cfg["checks"]["collision"] + 0.05):
+            g = b[j].copy()
+            g[3:5] += grow
+            out |= _in_box(self.grid.points, g)
+        return out
+
+    def propose(self, k: int, half: float):
+        """A candidate box and pose for object ``k``, or None when no location has mass left."""
+        v, cat = self.plan.ids[k], self.plan.categories[k]
+        inst = self.model_for(k)
+        anchors = anchors_of(v, self.plan, self.room, self.walls, self.sym, inst.half[:2])
+        parent = self.plan.parent[k]
+        pk = self.room.object_ids.index(parent) if parent in self.room.object_ids else None
+        if pk is None:  # on the floor, off the floor objects' footprints
+            mask = self.grid.floor & ~self.occupied(min(inst.half[:2]))
+        else:
+            mask = _in_box(self.grid.points, self.room.boxes[pk], max(inst.half[:2]))
+        for x, y in self.rejected.get(v, []):
+            mask &= (np.abs(self.grid.points[:, 0] - x) > half) | (np.abs(self.grid.points[:, 1] - y) > half)
+        if not mask.any():
+            return None
+        p = self.proposer.density(self.room, self.walls, cat, anchors, self.grid.points) * mask
+        if not np.isfinite(p).all() or p.sum() <= 0:
+            p = mask.astype(float)
+        cell = self.rng.choice(len(p), p=p / p.sum())
+        xy = self.grid.points[cell] + self.rng.uniform(-0.5, 0.5, 2) * self.grid.mpp
+        yaw = self.proposer.orientation(self.room, self.walls, cat, self.plan.symmetry[k], xy, self.rng)
+        support = None if pk is None else float(self.room.boxes[pk, 2] + self.room.boxes[pk, 5])
+        box, _ = place(inst, xy[0], xy[1], support, yaw)
+        box = snap(box, anchors, self.room, self.gaps, self.cfg["snap"]["reach"])
+        if pk is None:
+            box = inside_walls(box, self.walls, self.cfg["snap"]["gap"], self.cfg["snap"]["reach"])
+        box, pose = place(inst, box[0], box[1], support, yaw)
+        return xy, box, pose, inst.model_id, pk
+
+    def try_place(self, k: int) -> set[str] | None:
+        """Place object ``k`` within its sample budget: None on success, else the culprits of its failures."""
+        v = self.plan.ids[k]
+        culprits: set[str] = set()
+        budget = max(self.cfg["min_samples"], self.cfg["samples"] - self.backtracks // 5)
+        half = min(self.cfg["reject_half"] * self.cfg["reject_growth"] ** self.backtracks, self.cfg["reject_max_half"])
+        tol = tolerance(self.backtracks, self.cfg["max_backtracks"])
+        for _ in range(budget):
+            cand = self.propose(k, half)
+            if cand is None:
+                break
+            xy, box, pose, model, pk = cand
+            room = add_object(self.room, v, self.plan.categories[k], model, box, pose)
+            present = set(self.room.object_ids) | set(self.walls.ids)
+            verdict = check(room, len(room.object_ids) - 1, None if pk is None else pk, set(),
+                            planned_edges(v, self.plan, present), tol, self.checker)
+            if verdict.ok:
+                self.room = room
+                self.insertions += 1
+                return None
+            self.rejections += 1
+            log.debug("%s %s (%s) at %.2f, %.2f: %s", self.plan.scene_id, v, self.plan.categories[k], box[0], box[1], verdict.reason)
+            kind = verdict.reason.split(" ")[0]
+            self.failures[kind] = self.failures.get(kind, 0) + 1
+            self.rejected.setdefault(v, []).append((float(xy[0]), float(xy[1])))
+            culprits |= verdict.culprits
+        return culprits
+
+    def run(self, deadline: float) -> str:
+        """Place every object in order; '' on success, else why the scene failed."""
+        for u, unit in enumerate(chains(self.plan)):
+            for k in unit:
+                self.unit[k] = u
+        i = 0
+        while i < len(self.order):
+            if time.perf_counter() > deadline:
+                return f"time budget ({self.cfg['time_budget']} s) spent at object {i + 1} of {len(self.order)}"
+            k = self.order[i]
+            culprits = self.try_place(k)
+            if culprits is None:
+                i += 1
+                continue
+            if self.backtracks >= self.cfg["max_backtracks"]:
+                return f"backtrack budget ({self.cfg['max_backtracks']}) spent: no place for {self.plan.ids[k]} ({self.plan.categories[k]})"
+            self.backtracks += 1
+            if i == 0:  # nothing to undo: the first object tries again afresh
+                self.rejected.pop(self.plan.ids[k], None)
+                continue
+            placed = [self.plan.ids[j] for j in self.order[:i]]
+            earlier = [placed.index(c) for c in culprits if c in placed]
+            j = max(earlier) if earlier else i - 1
+            u = self.plan.ids[self.order[j]]
+            uk = self.room.object_ids.index(u)
+            self.rejected.setdefault(u, []).append(tuple(map(float, self.room.boxes[uk, :2])))
+            for later in self.order[j + 1:]:
+                self.rejected.pop(self.plan.ids[later], None)
+            self.room = with_objects(self.room, np.arange(self.fixed + j))
+            i = j
+        return ""
+
+
+def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, catalog: Catalog,
+                checker: Checker, cfg: dict, seed: int) -> Outcome:
+    """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed)."""
+    start = time.perf_counter()
+    s = Search(plan, room, walls, order, proposer, catalog, checker, cfg, np.random.default_rng(seed))
+    reason = s.run(start + cfg["time_budget"])
+    return Outcome(not reason, s.room, reason, time.perf_counter() - start, s.insertions, s.rejections, s.backtracks,
+                   s.failures)

@@ -1,0 +1,219 @@
+"""Instantiate graphs of one room type into rooms (one job per room type and variant): sampled graphs, or the
+held-out rooms' own final graphs (Table 3's ablations), placed by the search with the trained networks. Writes the
+generated rooms as canonical tables (every stage reads them unchanged), one record per scene (failed ones included,
+with their reason), and per scene a GLB, a top-down PNG with the planned graph, and a JSON summary."""
+from __future__ import annotations
+
+import json
+import logging
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import tables
+from ..errors import InputError
+from ..geometry.raycast import intersector_class
+from ..log import progress
+from ..placement import export, order, proposers, scene_metrics
+from ..placement.checks import Checker
+from ..placement.layout import walls_of, with_objects
+from ..placement.plan import ScenePlan, plans_from_tables
+from ..placement.retrieval import Catalog
+from ..placement.search import instantiate
+from .train_placement import load_rooms
+
+log = logging.getLogger("planit.instantiate")
+
+
+@dataclass
+class Context:
+    """Everything the scenes of one room type share."""
+    room_type: str
+    rooms: pd.DataFrame  # canonical rows of the source rooms
+    architecture: pd.DataFrame
+    objects: pd.DataFrame  # the corpus's objects of the room type
+    inputs: dict  # room id -> RoomInput (with its real objects)
+    catalog: Catalog
+    checker: Checker
+    mean_area: dict
+    heldout_ids: list[str]
+    models: list[Path]
+
+
+def load_context(config: dict, room_type: str, saved: dict, rooms: list[Path], architecture: list[Path],
+                 objects: list[Path], models: list[Path], symmetry: Path, category_sizes: Path) -> Context:
+    room_df, arch, objs, inputs = load_rooms(rooms, architecture, objects)
+    keep = room_df["room_type"].astype(str) == room_type
+    room_df = room_df[keep]
+    objs = objs[objs["room_id"].isin(set(room_df["room_id"]))]
+    held = set(saved["heldout_ids"])
+    sym_rows = tables.read(symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
+    sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
+    meshes, box_models = {}, set()
+    for p in models:
+        m, b = tables.read_meshes(p, objs["model_id"].dropna())
+        meshes.update(m)
+        box_models |= b
+    sizes = tables.read(category_sizes, "category_sizes").to_pandas()
+    sizes = sizes[sizes["room_type"].astype(str) == room_type]
+    ext = {**config["extract"], "floor_contact": config["floor_contact"]}
+    checker = Checker(meshes, box_models, sym, ext, intersector_class(ext["backend"]), config["instantiate"]["checks"])
+    return Context(room_type, room_df, arch[arch["room_id"].isin(set(room_df["room_id"]))], objs,
+                   {k: v for k, v in inputs.items() if k in set(room_df["room_id"])},
+                   Catalog(objs[~objs["room_id"].isin(held)], sym, config["floor_contact"]), checker,
+                   dict(zip(sizes["category"].astype(str), sizes["mean_area"])), list(saved["heldout_ids"]), models)
+
+
+def make_proposer(location: str, saved: dict, relation_mask: bool):
+    """The variant's proposer: network densities (cut to the relation bands when ``relation_mask``), uniform or
+    rule-band locations; orientations from the network."""
+    from ..learn.placement_proposer import NetProposer
+
+    nets = NetProposer(saved, film=location == "cfcn")
+    if location in ("cfcn", "fcn"):
+        return proposers.Masked(nets, proposers.RelationPrior()) if relation_mask else nets
+    return proposers.Combined(proposers.UniformLocation() if location == "random" else proposers.RelationPrior(), nets)
+
+
+def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dict, seed: int, keep: int = 0):
+    """Search one scene. ``keep``: the first objects of the constraint order stay where the source room has them
+    (completion of a real room)."""
+    source = ctx.inputs.get(plan.room_id)
+    if source is None:
+        raise InputError(f"scene {plan.scene_id}: its room {plan.room_id} is not among the kept rooms of {ctx.room_type}")
+    rng = np.random.default_rng(seed)
+    seq = order.placement_order(plan, ctx.mean_area, variant["ordering"] == "constraint", rng)
+    fixed = [plan.ids[k] for k in seq[:keep]]
+    start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
+    walls = walls_of(start)
+    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.catalog, ctx.checker, cfg, seed), walls
+
+
+def scene_rows(plan: ScenePlan, ctx: Context, outcome, walls, variant_name: str) -> tuple[dict, list[dict], list[dict], dict]:
+    """The scene's record and its rooms / architecture / objects rows (its room id is the scene id)."""
+    room = outcome.room
+    metrics = scene_metrics.consistency(plan, room, walls.ids, ctx.checker)
+    parents = dict(zip(plan.ids, plan.parent))
+    record = {"scene_id": plan.scene_id, "room_type": ctx.room_type, "variant": variant_name, "source_room_id": plan.room_id,
+              "status": "placed" if outcome.ok else "failed", "reason": outcome.reason, "seconds": outcome.seconds,
+              "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids), "insertions": outcome.insertions,
+              "rejections": outcome.rejections, "backtracks": outcome.backtracks, "failures": json.dumps(outcome.failures),
+              **metrics, "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
+    src = _records(ctx.rooms[ctx.rooms["room_id"] == plan.room_id])[0]
+    room_row = {**src, "room_id": plan.scene_id, "n_objects": len(room.object_ids), "shard": 0}
+    arch = _records(ctx.architecture[ctx.architecture["room_id"] == plan.room_id].assign(room_id=plan.scene_id))
+    objs = [{"room_id": plan.scene_id, "scene_id": plan.scene_id, "object_id": o, "category": c, "model_id": m,
+             **dict(zip(["cx", "cy", "cz", "hx", "hy", "hz", "yaw"], map(float, b))),
+             **dict(zip(["px", "py", "pz", "_yaw", "sx", "sy", "sz"], map(float, p))), "source_parent_id": parents.get(o)}
+            for o, c, m, b, p in zip(room.object_ids, room.categories, room.model_ids, room.boxes, room.poses)]
+    return record, [room_row], arch, objs
+
+
+def _records(frame: pd.DataFrame) -> list[dict]:
+    """Rows as dicts with missing values as None (not NaN)."""
+    return frame.astype(object).where(frame.notna(), None).to_dict("records")
+
+
+def write_scene_files(folder: Path, plan: ScenePlan, ctx: Context, outcome, walls, record: dict) -> None:
+    folder.mkdir(parents=True, exist_ok=True)
+    export.write_glb(folder / f"{plan.scene_id}.glb", outcome.room, walls, ctx.checker.meshes.get)
+    title = f"{plan.scene_id} ({record['status']}, consistency {record['consistency']:.2f})"
+    tables.write_figure(folder / f"{plan.scene_id}.png", export.plan_figure(outcome.room, walls, plan.edges, title))
+    tables.write_json(folder / f"{plan.scene_id}.json", record)
+
+
+def select_plans(config: dict, variant: dict, ctx: Context, nodes: Path, edges: Path, count: int) -> list[ScenePlan]:
+    flt = [("room_type", "=", ctx.room_type)]
+    if variant["graphs"] == "sampled":
+        node_df = tables.read(nodes, "generated_nodes", filters=flt).to_pandas()
+        edge_df = tables.read(edges, "generated_edges", filters=flt).to_pandas()
+    else:
+        held = [("room_id", "in", ctx.heldout_ids)]
+        node_df = tables.read(nodes, "final_nodes", filters=flt + held).to_pandas()
+        edge_df = tables.read(edges, "final_edges", filters=flt + held).to_pandas()
+    return plans_from_tables(node_df, edge_df, variant["pruning"], config["seed"])[:count]
+
+
+def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Path, model: Path, rooms: list[Path],
+        architecture: list[Path], objects: list[Path], models: list[Path], symmetry: Path, category_sizes: Path,
+        out_folder: Path, count: int | None = None) -> dict:
+    """Place ``count`` scenes (default ``instantiate.scenes``, or ``table3_scenes`` for held-out graphs)."""
+    import torch
+
+    ic = config["instantiate"]
+    if variant_name not in ic["variants"]:
+        raise InputError(f"--variant: '{variant_name}' is not in instantiate.variants ({', '.join(ic['variants'])})")
+    variant = ic["variants"][variant_name]
+    saved = torch.load(model, map_location="cpu", weights_only=False)
+    ctx = load_context(config, room_type, saved, rooms, architecture, objects, models, symmetry, category_sizes)
+    n = count or (ic["scenes"] if variant["graphs"] == "sampled" else ic["table3_scenes"])
+    plans = select_plans(config, variant, ctx, nodes, edges, n)
+    if not plans:
+        log.warning("%s: no graph of room type '%s' to instantiate: writing empty tables", nodes, room_type)
+    proposer = make_proposer(variant["location"], saved, config["instantiate"]["relation_mask"])
+    return write_outputs(config, ctx, plans, proposer, variant, variant_name, out_folder)
+
+
+def write_outputs(config: dict, ctx: Context, plans: list[ScenePlan], proposer, variant: dict, variant_name: str,
+                  out_folder: Path, keep: int = 0) -> dict:
+    records, room_rows, arch_rows, obj_rows = [], [], [], []
+    for plan in progress(plans, total=len(plans), desc=f"instantiate {ctx.room_type} ({variant_name})"):
+        seed = zlib.crc32(f"{config['seed']}/{variant_name}/{plan.scene_id}".encode())
+        outcome, walls = place_scene(plan, ctx, proposer, config["instantiate"], variant, seed, keep)
+        record, r, a, o = scene_rows(plan, ctx, outcome, walls, variant_name)
+        if not outcome.ok:
+            log.warning("scene %s failed: %s", plan.scene_id, outcome.reason)
+        write_scene_files(out_folder / "scenes", plan, ctx, outcome, walls, record)
+        records.append(record)
+        room_rows += r
+        arch_rows += a
+        obj_rows += o
+    objs = pd.DataFrame(obj_rows, columns=[*tables.SCHEMAS["generated_objects"].names, "_yaw"]).drop(columns="_yaw")
+    used = set(objs["model_id"])
+    tables.write(out_folder / "rooms.parquet", "rooms", tables.from_rows("rooms", room_rows))
+    tables.write(out_folder / "architecture.parquet", "architecture", tables.from_rows("architecture", arch_rows))
+    tables.write(out_folder / "objects.parquet", "generated_objects", tables.from_rows("generated_objects", _records(objs)))
+    model_rows = pd.concat([tables.read(p, "models", filters=[("model_id", "in", sorted(used))]).to_pandas()
+                            for p in (ctx.models if used else [])] + [tables.empty("models").to_pandas()])
+    tables.write(out_folder / "models.parquet", "models", tables.from_rows("models", _records(model_rows.drop_duplicates("model_id"))))
+    (out_folder / "scenes").mkdir(parents=True, exist_ok=True)
+    scenes = pd.DataFrame(records, columns=tables.SCHEMAS["scenes"].names)
+    tables.write(out_folder / "scenes.parquet", "scenes", tables.from_rows("scenes", records))
+    summary = summarise(scenes)
+    tables.write_json(out_folder / "summary.json", {"room_type": ctx.room_type, "variant": variant_name, **variant, **summary})
+    return summary
+
+
+def summarise(scenes: pd.DataFrame) -> dict:
+    """Table 3's figures over a variant's scenes."""
+    placed = scenes["status"] == "placed"
+    if scenes.empty:
+        return {"scenes": 0, "placed": 0, "failed": 0}
+    return {"scenes": int(len(scenes)), "placed": int(placed.sum()), "failed": int((~placed).sum()),
+            "rejections_per_scene": round(float(scenes["rejections"].mean()), 3),
+            "backtracks_per_insertion": round(float(scenes["backtracks"].sum() / max(scenes["insertions"].sum(), 1)), 4),
+            "violation": round(float(scenes.loc[placed, "violation"].mean()), 4) if placed.any() else None,
+            "consistency": round(float(scenes.loc[placed, "consistency"].mean()), 4) if placed.any() else None,
+            "collision_rate": round(float(scenes["colliding_objects"].sum() / max(scenes["placed_objects"].sum(), 1)), 4),
+            "median_seconds": round(float(scenes["seconds"].median()), 3),
+            "unplanned_adjacent_per_scene": round(float(scenes["unplanned_adjacent"].mean()), 3)}
+
+
+TABLE3_COLUMNS = ["variant", "scenes", "placed", "failed", "rejections_per_scene", "backtracks_per_insertion", "violation",
+                  "consistency", "collision_rate", "median_seconds", "unplanned_adjacent_per_scene"]
+
+
+def table3(summaries: list[Path], out: Path) -> pd.DataFrame:
+    """One row per variant's summary.json (PlanIT's Table 3 and our consistency), written as CSV."""
+    rows = []
+    for p in summaries:
+        try:
+            rows.append(json.loads(Path(p).read_text()))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise InputError(f"{p}: not a readable instantiation summary ({exc}); rerun snakemake --forcerun instantiate") from exc
+    frame = pd.DataFrame(rows).reindex(columns=["room_type", *TABLE3_COLUMNS])
+    tables.write_csv(out, frame)
+    return frame

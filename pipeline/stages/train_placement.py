@@ -1,0 +1,102 @@
+"""Train the placement networks (location CFCN + orientation) of one room type on the training rooms of the graph
+model's split (the same seeded held-out rooms are never trained on); ``film=False`` trains the unconditional FCN
+of the ablation."""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import pandas as pd
+
+from .. import tables
+from ..config import config_hash
+from ..errors import InputError
+from ..log import progress
+from ..roomdata import room_inputs
+
+log = logging.getLogger("planit.train_placement")
+
+
+def load_rooms(rooms: list[Path], architecture: list[Path], objects: list[Path], ids: set[str] | None = None):
+    """Canonical rows of the kept rooms (``ids``: only these) over every shard, as one RoomInput per room."""
+    flt = [("room_id", "in", sorted(ids))] if ids is not None else None
+    room_df = pd.concat([tables.read(p, "rooms", filters=flt).to_pandas() for p in rooms], ignore_index=True)
+    arch = pd.concat([tables.read(p, "architecture", filters=flt).to_pandas() for p in architecture], ignore_index=True)
+    objs = pd.concat([tables.read(p, "objects", filters=flt).to_pandas() for p in objects], ignore_index=True)
+    return room_df, arch, objs, {r.room_id: r for r in room_inputs(room_df, arch, objs)}
+
+
+def training_rooms(config: dict, room_type: str, rooms, architecture, objects, nodes: Path, edges: Path):
+    """Categories, training and held-out :class:`TrainingRoom` lists, and the held-out ids (the graph model's split)."""
+    from ..learn import graph_data
+    from ..learn.placement_data import training_room
+
+    flt = [("room_type", "=", room_type)]
+    node_df = tables.read(nodes, "final_nodes", filters=flt).to_pandas()
+    edge_df = tables.read(edges, "final_edges", filters=flt).to_pandas()
+    if node_df.empty:
+        raise InputError(f"{nodes}: no graph of room type '{room_type}'")
+    ids = sorted(node_df["room_id"].unique())
+    train_ids, held_ids = graph_data.split_heldout(ids, config["graph_model"]["heldout_fraction"], config["seed"])
+    _, _, objs, inputs = load_rooms(rooms, architecture, objects, set(ids))
+    cats = tuple(sorted(objs["category"].astype(str).unique()))
+    by_room_n, by_room_e = dict(tuple(node_df.groupby("room_id"))), dict(tuple(edge_df.groupby("room_id")))
+    make = lambda i: training_room(inputs[i], by_room_n[i], by_room_e.get(i, edge_df.iloc[:0]))
+    return cats, [make(i) for i in train_ids if i in inputs], [make(i) for i in held_ids if i in inputs], held_ids
+
+
+def run(config: dict, room_type: str, net: str, rooms: list[Path], architecture: list[Path], objects: list[Path],
+        nodes: Path, edges: Path, out_model: Path, out_history: Path, out_curve: Path, out_summary: Path,
+        threads: int = 1) -> dict:
+    import torch
+
+    from ..learn import placement_train
+    from ..learn.train import pick_device
+
+    pc = config["placement"]
+    preset = pc["presets"][pc["preset"]]
+    torch.set_num_threads(threads)
+    cats, train_rooms, held_rooms, held_ids = training_rooms(config, room_type, rooms, architecture, objects, nodes, edges)
+    if not train_rooms:
+        raise InputError(f"{nodes}: room type '{room_type}' has no training room")
+    device = pick_device(pc["device"])
+    chash = config_hash({"preset": preset, "net": net, "seed": config["seed"], "room_type": room_type,
+                         "rooms": sorted(t.room.room_id for t in train_rooms), "categories": cats})
+    bar = iter(progress(range(preset["steps"] // preset["log_every"] + 1), desc=f"train placement {room_type} ({net})"))
+
+    def tick(step, row):
+        next(bar, None)
+        log.info("step %d: location %.3f (held-out %.3f), orientation %.3f (held-out %.3f)", step, row["location_loss"],
+                 row["heldout_location_loss"], row["orientation_loss"], row["heldout_orientation_loss"])
+
+    nets, history = placement_train.train(train_rooms, held_rooms, cats, preset, net == "cfcn", config["seed"],
+                                          out_model.with_name("checkpoint.pt"), chash, device, tick)
+    tables.write_atomic(out_model, lambda tmp: torch.save({
+        "config_hash": chash, "room_type": room_type, "net": net, "categories": list(cats), "preset": preset,
+        "nets": [n.cpu().state_dict() for n in nets], "heldout_ids": held_ids}, tmp))
+    frame = pd.DataFrame(history)
+    tables.write_csv(out_history, frame)
+    tables.write_figure(out_curve, _curve(frame, room_type, net))
+    summary = {"room_type": room_type, "net": net, "preset": pc["preset"], "device": device, "train_rooms": len(train_rooms),
+               "heldout_rooms": len(held_rooms), "steps": int(frame["step"].iloc[-1]),
+               "train_seconds": round(float(frame["seconds"].iloc[-1]), 1),
+               "final_heldout_location_loss": round(float(frame["heldout_location_loss"].iloc[-1]), 4),
+               "final_heldout_orientation_loss": round(float(frame["heldout_orientation_loss"].iloc[-1]), 4)}
+    tables.write_json(out_summary, summary)
+    return summary
+
+
+def _curve(history, room_type: str, net: str):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))
+    for ax, name in zip(axes, ("location", "orientation")):
+        ax.plot(history["step"], history[f"{name}_loss"], label="train")
+        ax.plot(history["step"], history[f"heldout_{name}_loss"], label="held-out")
+        ax.set(xlabel="step", ylabel="loss", title=f"{name}, {room_type} ({net})")
+        ax.legend()
+    fig.tight_layout()
+    return fig
