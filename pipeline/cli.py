@@ -308,12 +308,13 @@ def instantiate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] =
                 architecture: List[Path] = _files("--architecture"), objects: List[Path] = _files("--objects"),
                 models: List[Path] = _files("--models"), symmetry: Path = _file("--symmetry"),
                 category_sizes: Path = _file("--category-sizes"), out: Path = _file("--out", "output folder"),
-                n: Optional[int] = typer.Option(None, "-n", "--count", help="scenes (default from instantiate)")) -> None:
+                n: Optional[int] = typer.Option(None, "-n", "--count", help="scenes (default from instantiate)"),
+                threads: int = typer.Option(1, "--threads", help="CPU threads (the rule's threads)")) -> None:
     """Place graphs of one room type into rooms: canonical tables, a record per scene, GLB / PNG / JSON per scene."""
     from .stages import instantiate as stage
 
     _summary(_stage(stage.run, config, config_json, room_type, variant, nodes, edges, model, rooms, architecture, objects,
-                    models, symmetry, category_sizes, out, n))
+                    models, symmetry, category_sizes, out, n, threads))
 
 
 @app.command()

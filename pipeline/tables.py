@@ -316,6 +316,11 @@ def from_rows(name: str, rows: Iterable[dict]) -> pa.Table:
     return pa.table({f.name: pa.array(cols[f.name], type=_plain(f.type)) for f in schema}).cast(schema)
 
 
+def records(frame) -> list[dict]:
+    """A pandas frame's rows as dicts with missing values as None, not NaN (what :func:`from_rows` takes)."""
+    return frame.astype(object).where(frame.notna(), None).to_dict("records")
+
+
 def _plain(t: pa.DataType) -> pa.DataType:
     return t.value_type if pa.types.is_dictionary(t) else t
 

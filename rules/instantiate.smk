@@ -68,7 +68,7 @@ rule instantiate:
         ENV
     shell:
         "planit instantiate --config-json {params.config:q} --room-type {wildcards.room_type} "
-        "--variant {wildcards.variant} --nodes {input.nodes} --edges {input.edges} --model {input.model} "
+        "--variant {wildcards.variant} --threads {threads} --nodes {input.nodes} --edges {input.edges} --model {input.model} "
         "{params.rooms} {params.architecture} {params.objects} {params.models} --symmetry {input.symmetry} "
         "--category-sizes {input.category_sizes} --out {params.folder} 2> {log}"
 

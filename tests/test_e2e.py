@@ -177,6 +177,41 @@ def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
         assert (run_dir / "logs" / "train_graph_model" / f"{room_type}.log").stat().st_size > 0
 
 
+def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_path):
+    from pipeline import config as config_mod
+    from pipeline.stages import extract_graphs
+
+    res = run_dir / "results"
+    for room_type in ("bedroom", "living", "office", "bathroom", "kitchen"):
+        training = json.loads((res / "placement" / room_type / "cfcn" / "training.json").read_text())
+        assert training["steps"] == 20 and training["train_rooms"] >= 1
+        assert (res / "placement" / room_type / "cfcn" / "loss.png").stat().st_size > 1000
+        folder = res / "generated" / room_type / "planit"
+        scenes = pd.read_parquet(folder / "scenes.parquet")
+        sampled = pd.read_parquet(res / "graph_model" / room_type / "sampled" / "nodes.parquet").scene_id.nunique()
+        assert len(scenes) == min(3, sampled)  # failed scenes are recorded, never dropped
+        assert set(scenes.status) <= {"placed", "failed"} and (scenes[scenes.status == "failed"].reason != "").all()
+        for scene in scenes.scene_id:
+            for ext in ("glb", "png", "json"):
+                assert (folder / "scenes" / f"{scene}.{ext}").stat().st_size > 0
+        objs = pd.read_parquet(folder / "objects.parquet")
+        assert (objs.scene_id == objs.room_id).all()
+        assert objs.groupby("room_id").size().reindex(scenes.scene_id, fill_value=0).tolist() == scenes.placed_objects.tolist()
+    table = pd.read_csv(res / "generated" / "bedroom" / "table3.csv")
+    assert table.variant.tolist() == ["heldout", "random_location", "unconditional", "no_pruning", "half_pruning",
+                                      "no_ordering"]
+    assert (res / "placement" / "bedroom" / "fcn" / "model.pt").exists()
+    # the generated bedrooms run through the extraction stage unchanged
+    gen = res / "generated" / "bedroom" / "planit"
+    placed = pd.read_parquet(gen / "scenes.parquet").placed_objects.sum()
+    cfg = config_mod.validate({"seed": 7})
+    extract_graphs.run(cfg, 0, gen / "rooms.parquet", gen / "architecture.parquet", gen / "objects.parquet",
+                       gen / "models.parquet", res / "graphs/ingested/symmetry.parquet", tmp_path / "n.parquet",
+                       tmp_path / "e.parquet", tmp_path / "s.json")
+    nodes = pd.read_parquet(tmp_path / "n.parquet")
+    assert (nodes.kind == "object").sum() == placed
+
+
 def test_invalid_config_names_the_key_in_one_line(tmp_path):
     out = snakemake(tmp_path, "--dry-run", "--config", "shards=0", check=False)
     text = out.stderr + out.stdout

@@ -206,7 +206,10 @@ def test_procedural_rules_hold_on_real_graphs(bedrooms):
 def test_extraction_and_refinement_never_import_torch():
     code = ("import sys; import pipeline.extraction, pipeline.filtering, pipeline.graphs.refine, pipeline.stages.ingest, "
             "pipeline.stages.extract_graphs, pipeline.stages.refine_graphs, pipeline.cli, pipeline.learn.graph_data, "
-            "pipeline.learn.graph_checks, pipeline.learn.graph_metrics; assert 'torch' not in sys.modules, 'torch'")
+            "pipeline.learn.graph_checks, pipeline.learn.graph_metrics, pipeline.learn.placement_data, "
+            "pipeline.placement.search, pipeline.placement.checks, pipeline.placement.export, "
+            "pipeline.placement.scene_metrics, pipeline.stages.instantiate, pipeline.stages.generate; "
+            "assert 'torch' not in sys.modules, 'torch'")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
 

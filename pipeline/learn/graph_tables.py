@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from .. import tables
 from ..geometry.symmetry import TYPES as SYMMETRIES
 from .graph_data import EDGE_CLASSES, N_OBJECT_EDGES, ROLES, Vocab
 from .sampler import Grown
@@ -38,10 +39,6 @@ def _tiers(n_arch: int, n: int, parent: dict[int, int]) -> list[int]:
     return tier
 
 
-def _records(frame: pd.DataFrame) -> list[dict]:
-    """Rows as dicts with missing values as None (not NaN)."""
-    return frame.astype(object).where(frame.notna(), None).to_dict("records")
-
 
 def grown_rows(g: Grown, vocab: Vocab, arch_nodes: pd.DataFrame, arch_edges: pd.DataFrame, scene_id: str,
                room_type: str, seed: int) -> tuple[list[dict], list[dict]]:
@@ -53,13 +50,13 @@ def grown_rows(g: Grown, vocab: Vocab, arch_nodes: pd.DataFrame, arch_edges: pd.
     tier = _tiers(n_arch, len(ids), parent)
     extra = {"room_id": scene_id, "scene_id": scene_id, "source_room_id": g.arch.room_id, "sample_seed": int(seed),
              "room_type": room_type, "shard": 0}
-    nodes = [dict(r, **extra) for r in _records(arch_nodes)]
+    nodes = [dict(r, **extra) for r in tables.records(arch_nodes)]
     for k in range(n_arch, len(ids)):
         nodes.append({**extra, "node_id": ids[k], "kind": "object", "category": vocab.node_classes[g.node_class[k]],
                       "symmetry": SYMMETRIES[g.symmetry[k]], "symmetry_origin": "sampled", "tier": tier[k],
                       "parent_id": ids[parent[k]] if k in parent and parent[k] >= n_arch else None,
                       "role": ROLE_NAMES[ROLES[g.role[k]]], "group_id": None})
-    edges = [dict(r, **extra) for r in _records(arch_edges)]
+    edges = [dict(r, **extra) for r in tables.records(arch_edges)]
     for s, t, c in g.edges:
         kind, d, dist = _edge_fields(c)
         if kind is not None:

@@ -23,8 +23,9 @@ def room_scene(room: RoomInput, walls: Walls, mesh_of):
     scene = trimesh.Scene()
     tris = shapely.constrained_delaunay_triangles(shapely.Polygon(room.outline))  # GEOS: no extra triangulation engine
     corners = np.array([np.asarray(t.exterior.coords)[:3] for t in tris.geoms])
-    corners[np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]) < 0] = corners[:, ::-1][
-        np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]) < 0]
+    d1, d2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    clockwise = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] < 0
+    corners[clockwise] = corners[clockwise, ::-1]  # prisms take counter-clockwise outlines
     v, f = meshes.prisms(corners, -0.02, 0.0)
     scene.add_geometry(trimesh.Trimesh(v, f, process=False), node_name="floor", geom_name="floor", metadata={"kind": "floor"})
     for wid, corners in zip(walls.ids, wall_footprints(walls)):

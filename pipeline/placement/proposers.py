@@ -34,8 +34,8 @@ class RelationPrior:
     :data:`BANDS` says for the edge's distance and as wide as the side plus ``margin`` m; anchors multiply. A
     baseline, and the proposer of the tests that must not depend on training."""
 
-    def __init__(self, margin: float = 0.6):
-        self.margin = margin
+    def __init__(self, margin: float = 0.6, soft: float = 0.0):
+        self.margin, self.soft = margin, soft  # soft: the density outside a band (0: none)
 
     def density(self, room: RoomInput, walls: Walls, category: str, anchors, points: np.ndarray) -> np.ndarray:
         out = np.ones(len(points))
@@ -51,7 +51,8 @@ class RelationPrior:
                 along, half_len = local[:, 1 - axis], (hx if axis == 1 else hy)
             lo, hi = BANDS[a.distance]
             small, large = min(a.target_half), max(a.target_half)
-            out *= (depth >= small + lo) & (depth <= large + hi) & (np.abs(along) <= half_len + self.margin)
+            inside = (depth >= small + lo) & (depth <= large + hi) & (np.abs(along) <= half_len + self.margin)
+            out *= np.where(inside, 1.0, self.soft)
         return out
 
 
@@ -78,12 +79,13 @@ class Combined:
 
 @dataclass
 class Masked:
-    """A proposer whose densities are cut to where ``mask`` has mass (e.g. the network's within the relation bands)."""
+    """A proposer whose densities are weighted by ``mask``'s (e.g. the network's by the relation bands: with soft
+    bands, where fewer relations can hold is unlikely, not impossible)."""
     base: object
     mask: object
 
     def density(self, *args) -> np.ndarray:
-        return self.base.density(*args) * (self.mask.density(*args) > 0)
+        return self.base.density(*args) * self.mask.density(*args)
 
     def orientation(self, *args) -> float:
         return self.base.orientation(*args)

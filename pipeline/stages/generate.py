@@ -43,6 +43,7 @@ def complete(config: dict, room: str, keep: int, folder: Path | None) -> dict:
     """Keep the first ``keep`` objects (of the placement order) of a real room and place the rest of its graph."""
     import torch
 
+    torch.set_num_threads(1)
     flt = [("room_id", "=", room)]
     nodes = tables.read(GRAPHS / "nodes.parquet", "final_nodes", filters=flt).to_pandas()
     if nodes.empty:
@@ -57,7 +58,7 @@ def complete(config: dict, room: str, keep: int, folder: Path | None) -> dict:
     p = corpus_paths(config)
     ctx = instantiate.load_context(config, room_type, saved, p["rooms"], p["architecture"], p["objects"], p["models"],
                                    p["symmetry"], p["category_sizes"])
-    proposer = instantiate.make_proposer("cfcn", saved, config["instantiate"]["relation_mask"])
+    proposer = instantiate.make_proposer("cfcn", saved, config["instantiate"])
     variant = config["instantiate"]["variants"]["heldout"]
     folder = folder or Path("results/generated") / room_type / f"complete_{room}"
     return instantiate.write_outputs(config, ctx, [plan], proposer, variant, "complete", folder, keep)

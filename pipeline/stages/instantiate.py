@@ -67,14 +67,15 @@ def load_context(config: dict, room_type: str, saved: dict, rooms: list[Path], a
                    dict(zip(sizes["category"].astype(str), sizes["mean_area"])), list(saved["heldout_ids"]), models)
 
 
-def make_proposer(location: str, saved: dict, relation_mask: bool):
-    """The variant's proposer: network densities (cut to the relation bands when ``relation_mask``), uniform or
-    rule-band locations; orientations from the network."""
+def make_proposer(location: str, saved: dict, cfg: dict):
+    """The variant's proposer: network densities (weighted by the relation bands when ``relation_mask``), uniform or
+    rule-band locations; orientations from the network. ``cfg``: the instantiate section."""
     from ..learn.placement_proposer import NetProposer
 
     nets = NetProposer(saved, film=location == "cfcn")
     if location in ("cfcn", "fcn"):
-        return proposers.Masked(nets, proposers.RelationPrior()) if relation_mask else nets
+        bands = proposers.RelationPrior(soft=cfg["band_softness"])
+        return proposers.Masked(nets, bands) if cfg["relation_mask"] else nets
     return proposers.Combined(proposers.UniformLocation() if location == "random" else proposers.RelationPrior(), nets)
 
 
@@ -102,19 +103,15 @@ def scene_rows(plan: ScenePlan, ctx: Context, outcome, walls, variant_name: str)
               "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids), "insertions": outcome.insertions,
               "rejections": outcome.rejections, "backtracks": outcome.backtracks, "failures": json.dumps(outcome.failures),
               **metrics, "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
-    src = _records(ctx.rooms[ctx.rooms["room_id"] == plan.room_id])[0]
+    src = tables.records(ctx.rooms[ctx.rooms["room_id"] == plan.room_id])[0]
     room_row = {**src, "room_id": plan.scene_id, "n_objects": len(room.object_ids), "shard": 0}
-    arch = _records(ctx.architecture[ctx.architecture["room_id"] == plan.room_id].assign(room_id=plan.scene_id))
+    arch = tables.records(ctx.architecture[ctx.architecture["room_id"] == plan.room_id].assign(room_id=plan.scene_id))
     objs = [{"room_id": plan.scene_id, "scene_id": plan.scene_id, "object_id": o, "category": c, "model_id": m,
              **dict(zip(["cx", "cy", "cz", "hx", "hy", "hz", "yaw"], map(float, b))),
              **dict(zip(["px", "py", "pz", "_yaw", "sx", "sy", "sz"], map(float, p))), "source_parent_id": parents.get(o)}
             for o, c, m, b, p in zip(room.object_ids, room.categories, room.model_ids, room.boxes, room.poses)]
     return record, [room_row], arch, objs
 
-
-def _records(frame: pd.DataFrame) -> list[dict]:
-    """Rows as dicts with missing values as None (not NaN)."""
-    return frame.astype(object).where(frame.notna(), None).to_dict("records")
 
 
 def write_scene_files(folder: Path, plan: ScenePlan, ctx: Context, outcome, walls, record: dict) -> None:
@@ -139,10 +136,12 @@ def select_plans(config: dict, variant: dict, ctx: Context, nodes: Path, edges: 
 
 def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Path, model: Path, rooms: list[Path],
         architecture: list[Path], objects: list[Path], models: list[Path], symmetry: Path, category_sizes: Path,
-        out_folder: Path, count: int | None = None) -> dict:
-    """Place ``count`` scenes (default ``instantiate.scenes``, or ``table3_scenes`` for held-out graphs)."""
+        out_folder: Path, count: int | None = None, threads: int = 1) -> dict:
+    """Place ``count`` scenes (default ``instantiate.scenes``, or ``table3_scenes`` for held-out graphs) with
+    ``threads`` CPU threads for the networks (more than the job's cores oversubscribe them: 4x slower)."""
     import torch
 
+    torch.set_num_threads(threads)
     ic = config["instantiate"]
     if variant_name not in ic["variants"]:
         raise InputError(f"--variant: '{variant_name}' is not in instantiate.variants ({', '.join(ic['variants'])})")
@@ -153,7 +152,7 @@ def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Pat
     plans = select_plans(config, variant, ctx, nodes, edges, n)
     if not plans:
         log.warning("%s: no graph of room type '%s' to instantiate: writing empty tables", nodes, room_type)
-    proposer = make_proposer(variant["location"], saved, config["instantiate"]["relation_mask"])
+    proposer = make_proposer(variant["location"], saved, config["instantiate"])
     return write_outputs(config, ctx, plans, proposer, variant, variant_name, out_folder)
 
 
@@ -175,10 +174,10 @@ def write_outputs(config: dict, ctx: Context, plans: list[ScenePlan], proposer, 
     used = set(objs["model_id"])
     tables.write(out_folder / "rooms.parquet", "rooms", tables.from_rows("rooms", room_rows))
     tables.write(out_folder / "architecture.parquet", "architecture", tables.from_rows("architecture", arch_rows))
-    tables.write(out_folder / "objects.parquet", "generated_objects", tables.from_rows("generated_objects", _records(objs)))
+    tables.write(out_folder / "objects.parquet", "generated_objects", tables.from_rows("generated_objects", tables.records(objs)))
     model_rows = pd.concat([tables.read(p, "models", filters=[("model_id", "in", sorted(used))]).to_pandas()
                             for p in (ctx.models if used else [])] + [tables.empty("models").to_pandas()])
-    tables.write(out_folder / "models.parquet", "models", tables.from_rows("models", _records(model_rows.drop_duplicates("model_id"))))
+    tables.write(out_folder / "models.parquet", "models", tables.from_rows("models", tables.records(model_rows.drop_duplicates("model_id"))))
     (out_folder / "scenes").mkdir(parents=True, exist_ok=True)
     scenes = pd.DataFrame(records, columns=tables.SCHEMAS["scenes"].names)
     tables.write(out_folder / "scenes.parquet", "scenes", tables.from_rows("scenes", records))

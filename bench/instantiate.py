@@ -1,0 +1,100 @@
+"""Instantiation on one core: seconds per scene and outcomes of the default search on sampled graphs, and how
+good the placement networks are on held-out rooms (location: CFCN mass near the true centre; orientation: the
+network's most likely bin against the face-away-from-the-wall rule).
+
+    .venv/bin/python bench/instantiate.py [--room-type bedroom] [--scenes 30] [--probes 60]
+
+Reads a pipeline run's outputs (make pipeline first): the sampled graphs, the corpus tables and
+results/placement/<type>/cfcn/model.pt.
+"""
+from __future__ import annotations
+
+import platform
+import statistics
+import zlib
+
+import numpy as np
+import torch
+
+from pipeline import config as config_mod
+from pipeline.geometry.frames import yaw_to_local
+from pipeline.learn.placement_data import bin_targets, orientation_frame
+from pipeline.learn.placement_proposer import NetProposer
+from pipeline.placement.layout import render, with_objects
+from pipeline.placement.plan import PlanEdge, ScenePlan
+from pipeline.placement.proposers import FaceAway
+from pipeline.placement.search import Grid, anchors_of
+from pipeline.stages import generate, instantiate, train_placement
+
+from common import ROOT, arguments, report
+
+
+def probe_networks(cfg, room_type: str, saved: dict, probes: int) -> dict:
+    """On held-out rooms, remove one object at a time and ask the networks for it."""
+    p = generate.corpus_paths(cfg)
+    _, _, held, _ = train_placement.training_rooms(cfg, room_type, p["rooms"], p["architecture"], p["objects"],
+                                                   ROOT / "results/graphs/ingested/nodes.parquet",
+                                                   ROOT / "results/graphs/ingested/edges.parquet")
+    net, rng = NetProposer(saved), np.random.default_rng(0)
+    near, net_hits, rule_hits, n = [], 0, 0, 0
+    for t in (held[int(rng.integers(len(held)))] for _ in range(probes)):
+        room = t.room
+        k = int(rng.integers(len(room.object_ids)))
+        v, cat = room.object_ids[k], room.categories[k]
+        kept = with_objects(room, [j for j in range(len(room.object_ids)) if j != k])
+        plan = ScenePlan("probe", room.room_id, room_type, room.object_ids, room.categories, ["none"] * len(room.object_ids),
+                         [1] * len(room.object_ids), [None] * len(room.object_ids), ["none"] * len(room.object_ids),
+                         [PlanEdge(s, tt, "spatial", d, x) for s, tt, d, x in t.edges])
+        anchors = anchors_of(v, plan, kept, t.walls, t.symmetry)
+        if anchors and cat in net.categories:
+            grid = Grid(room.outline, 0.05)
+            d = net.density(kept, t.walls, cat, anchors, grid.points) * grid.floor
+            near.append(float(d[np.linalg.norm(grid.points - room.boxes[k, :2], axis=1) < 0.25].sum() / d.sum()))
+        frame = orientation_frame(t.walls, room.boxes[k, :2])
+        bins = bin_targets(float(yaw_to_local(frame, room.boxes[k, 6])), t.symmetry.get(v, "none"), net.preset["bins"])
+        if bins.all() or cat not in net.categories:
+            continue
+        with torch.no_grad():
+            logits = net.ori(torch.as_tensor(render(kept, t.walls, net.ori_view, frame)[None]))[0, net.categories.index(cat)]
+        net_hits += bool(bins[int(logits.argmax())])
+        rule = FaceAway().orientation(kept, t.walls, cat, "none", room.boxes[k, :2], rng)
+        rule_hits += bool(bins[int(np.round(yaw_to_local(frame, rule) / (2 * np.pi / len(bins)))) % len(bins)])
+        n += 1
+    return {"location_mass_within_0.25m": round(float(np.mean(near)), 3), "location_probes": len(near),
+            "orientation_accuracy_network": round(net_hits / max(n, 1), 3),
+            "orientation_accuracy_face_away_rule": round(rule_hits / max(n, 1), 3), "orientation_probes": n}
+
+
+def main() -> None:
+    ap = arguments(__doc__)
+    ap.add_argument("--room-type", default="bedroom")
+    ap.add_argument("--scenes", type=int, default=30)
+    ap.add_argument("--probes", type=int, default=60)
+    args = ap.parse_args()
+    torch.set_num_threads(1)
+    cfg = config_mod.load(ROOT / "config" / "config.yaml")
+    saved = torch.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", map_location="cpu", weights_only=False)
+    p = generate.corpus_paths(cfg)
+    ctx = instantiate.load_context(cfg, args.room_type, saved, p["rooms"], p["architecture"], p["objects"], p["models"],
+                                   p["symmetry"], p["category_sizes"])
+    variant = cfg["instantiate"]["variants"]["planit"]
+    graphs = ROOT / "results/graph_model" / args.room_type / "sampled"
+    plans = instantiate.select_plans(cfg, variant, ctx, graphs / "nodes.parquet", graphs / "edges.parquet", args.scenes)
+    proposer = instantiate.make_proposer("cfcn", saved, cfg["instantiate"])
+    rows = []
+    for plan in plans:
+        seed = zlib.crc32(f"{cfg['seed']}/bench/{plan.scene_id}".encode())
+        out, walls = instantiate.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
+        rows.append((out.ok, out.seconds, instantiate.scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker)["consistency"]))
+    placed = [r for r in rows if r[0]]
+    result = {"room_type": args.room_type, "scenes": len(rows), "placed": len(placed),
+              "median_seconds_per_scene": round(statistics.median(r[1] for r in rows), 3),
+              "median_seconds_placed": round(statistics.median(r[1] for r in placed), 3) if placed else None,
+              "mean_consistency_placed": round(float(np.mean([r[2] for r in placed])), 4) if placed else None,
+              **probe_networks(cfg, args.room_type, saved, args.probes),
+              "machine": platform.processor() or platform.machine(), "threads": 1}
+    report(result, args.workdir, f"instantiate_{args.room_type}")
+
+
+if __name__ == "__main__":
+    main()
