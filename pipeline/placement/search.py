@@ -150,10 +150,11 @@ def tolerance(backtracks: int, budget: int) -> float:
     return 0.0 if backtracks < start else min(1.0, ((backtracks - start) / max(budget - start, 1e-9)) ** 1.5)
 
 
-def _in_box(points: np.ndarray, b: np.ndarray, inset: float = 0.0) -> np.ndarray:
-    """``(m,)`` points inside box ``b``'s footprint shrunk by ``inset`` m (never below a centimetre across)."""
+def _in_box(points: np.ndarray, b: np.ndarray, inset=(0.0, 0.0), least: float = 0.0) -> np.ndarray:
+    """``(m,)`` points inside box ``b``'s footprint shrunk by ``inset`` (x, y) m in its frame, each half extent kept
+    >= ``least`` m."""
     local = (points - b[:2]) @ rotation(b[6])
-    return (np.abs(local[:, 0]) <= max(b[3] - inset, 0.01)) & (np.abs(local[:, 1]) <= max(b[4] - inset, 0.01))
+    return ((np.abs(local[:, 0]) <= max(b[3] - inset[0], least)) & (np.abs(local[:, 1]) <= max(b[4] - inset[1], least)))
 
 
 class Search:
@@ -199,16 +200,22 @@ class Search:
         return out
 
     def propose(self, k: int, half: float):
-        """A candidate box and pose for object ``k``, or None when no location has mass left."""
-        v, cat = self.plan.ids[k], self.plan.categories[k]
+        """A candidate box and pose for object ``k``, or None when no location has mass left. A supported object
+        turns first (to its support's axes) so that its footprint can be kept on the support's top."""
+        v, cat, sym = self.plan.ids[k], self.plan.categories[k], self.plan.symmetry[k]
         inst = self.model_for(k)
         anchors = anchors_of(v, self.plan, self.room, self.walls, self.sym, inst.half[:2])
         parent = self.plan.parent[k]
         pk = self.room.object_ids.index(parent) if parent in self.room.object_ids else None
         if pk is None:  # on the floor, off the floor objects' footprints
-            mask = self.grid.floor & ~self.occupied(min(inst.half[:2]))
+            mask, yaw = self.grid.floor & ~self.occupied(min(inst.half[:2])), None
         else:
-            mask = _in_box(self.grid.points, self.room.boxes[pk], max(inst.half[:2]))
+            pb = self.room.boxes[pk]
+            yaw = self.proposer.orientation(self.room, self.walls, cat, sym, pb[:2], self.rng)
+            turns = int(np.round((yaw - pb[6]) / (np.pi / 2)))
+            yaw = float(pb[6] + turns * np.pi / 2)
+            inset = inst.half[:2][::-1] if turns % 2 else inst.half[:2]
+            mask = _in_box(self.grid.points, pb, inset, self.grid.mpp / 2)
         for x, y in self.rejected.get(v, []):
             mask &= (np.abs(self.grid.points[:, 0] - x) > half) | (np.abs(self.grid.points[:, 1] - y) > half)
         if not mask.any():
@@ -218,7 +225,8 @@ class Search:
             p = mask.astype(float)
         cell = self.rng.choice(len(p), p=p / p.sum())
         xy = self.grid.points[cell] + self.rng.uniform(-0.5, 0.5, 2) * self.grid.mpp
-        yaw = self.proposer.orientation(self.room, self.walls, cat, self.plan.symmetry[k], xy, self.rng)
+        if yaw is None:
+            yaw = self.proposer.orientation(self.room, self.walls, cat, sym, xy, self.rng)
         support = None if pk is None else float(self.room.boxes[pk, 2] + self.room.boxes[pk, 5])
         box, _ = place(inst, xy[0], xy[1], support, yaw)
         box = snap(box, anchors, self.room, self.gaps, self.cfg["snap"]["reach"])
