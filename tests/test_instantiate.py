@@ -183,6 +183,13 @@ def test_the_glb_reloads_with_one_node_per_object_wall_and_the_floor(tmp_path):
     assert names == set(plan.ids) | set(walls.ids) | {"floor"}
     assert len(names) == len(scene.graph.nodes_geometry) == 5 + len(walls.ids) + 1
     assert np.allclose(back.bounds, scene.bounds, atol=1e-5)
+    import json
+    import struct
+
+    raw = path.read_bytes()  # the glTF JSON chunk: every object node carries its category in its extras
+    nodes = json.loads(raw[20:20 + struct.unpack("<I", raw[12:16])[0]])["nodes"]
+    cats = {n["name"]: n.get("extras", {}).get("category") for n in nodes}
+    assert all(cats[o] == c for o, c in zip(out.room.object_ids, out.room.categories))
     fig = export.plan_figure(out.room, walls, plan.edges, "s0")
     fig.savefig(tmp_path / "s0.png")
     assert (tmp_path / "s0.png").stat().st_size > 5000
