@@ -280,6 +280,12 @@ def graph_model_metrics(config: Optional[Path] = ConfigOpt, config_json: Optiona
     typer.echo(json.dumps(result["goals"]))
 
 
+def _workflow_config() -> Optional[Path]:
+    """config/config.yaml of the current folder, the config a `snakemake` run here used (None: the defaults)."""
+    path = Path("config/config.yaml")
+    return path if path.exists() else None
+
+
 @app.command("train-placement")
 def train_placement(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
                     room_type: str = typer.Option(..., "--room-type"),
@@ -332,9 +338,12 @@ def generate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = Js
              n: int = typer.Option(10, "-n", "--count", help="rooms"),
              out: Optional[Path] = typer.Option(None, "--out", help="default results/generated/<type>/cli (or spec_<name>)")) -> None:
     """Sample graphs with the trained graph model (from scratch or completing --spec) and place them, end to end to
-    GLB; needs the trained models of `snakemake` (results/graph_model, results/placement)."""
+    GLB; needs the trained models of `snakemake` (results/graph_model, results/placement). The config defaults to
+    the workflow's config/config.yaml."""
     from .stages import generate as stage
     from .stages import sample_graphs
+
+    config = config or _workflow_config()
 
     if room_type is None:
         if spec is None:
@@ -349,8 +358,10 @@ def complete(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = Js
              room: str = typer.Option(..., "--room", help="a kept room of the corpus"),
              keep: int = typer.Option(3, "--keep", help="objects kept where they are (the first of the placement order)"),
              out: Optional[Path] = typer.Option(None, "--out", help="default results/generated/<type>/complete_<room>")) -> None:
-    """Keep a real room's first objects and place the rest of its graph around them."""
+    """Keep a real room's first objects and place the rest of its graph around them (config: as for generate)."""
     from .stages import generate as stage
+
+    config = config or _workflow_config()
 
     _summary(_stage(stage.complete, config, config_json, room, keep, out))
 

@@ -6,6 +6,9 @@ import pytest
 
 from test_e2e import COMPARE, snakemake
 
+sys.path.insert(0, str(COMPARE.parent))
+from compare_runs import GATHERED  # noqa: E402
+
 pytestmark = pytest.mark.slow
 
 
@@ -19,7 +22,8 @@ def test_sharding_and_hash_seeds_change_nothing(tmp_path):
     for name, shards, seed in (("one", 1, "1"), ("two", 2, "2")):
         override = tmp_path / f"{name}.yaml"
         override.write_text(base + f"shards: {shards}\n")
-        snakemake(tmp_path / name, extra_config=override, env_extra={"PYTHONHASHSEED": seed})
+        snakemake(tmp_path / name, *(f"results/{t}" for t in GATHERED), extra_config=override,
+                  env_extra={"PYTHONHASHSEED": seed})
     out = subprocess.run([sys.executable, str(COMPARE), "--gathered", str(tmp_path / "one" / "results"),
                           str(tmp_path / "two" / "results")], capture_output=True, text=True)
     assert out.returncode == 0, out.stdout

@@ -33,7 +33,7 @@ def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path 
     return proc
 
 
-GRAPH_MODEL_RULES = ("train_graph_model", "sample_graphs", "graph_model_metrics")
+GRAPH_MODEL_RULES = ("train_graph_model", "sample_graphs", "graph_model_metrics", "train_placement", "instantiate", "table3")
 
 
 def planned_jobs(proc: subprocess.CompletedProcess) -> set[str]:
@@ -47,6 +47,7 @@ def planned_jobs(proc: subprocess.CompletedProcess) -> set[str]:
 def run_dir(tmp_path_factory):
     work = tmp_path_factory.mktemp("e2e")
     snakemake(work)
+    snakemake(work, "results/generated/bedroom/table3.csv")  # tiny.yaml leaves Table 3 out of the default target
     return work
 
 
@@ -154,7 +155,12 @@ def test_forcerun_refine_reruns_only_refinement_and_after(run_dir):
 def test_a_sampling_setting_resamples_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n"
                                             "graph_model:\n  sample: {graphs: 20, batch_size: 20, temperature: 0.8}\n")
-    assert jobs == {"sample_graphs", "graph_model_metrics"}
+    assert jobs == {"sample_graphs", "graph_model_metrics", "instantiate"}  # the sampled graphs are placed again
+
+
+def test_a_search_setting_replaces_without_retraining(run_dir, tmp_path):
+    jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\ninstantiate:\n  samples: 12\n")
+    assert jobs == {"instantiate", "table3"}  # run_dir holds the bedroom Table 3
 
 
 def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
@@ -189,7 +195,7 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
         folder = res / "generated" / room_type / "planit"
         scenes = pd.read_parquet(folder / "scenes.parquet")
         sampled = pd.read_parquet(res / "graph_model" / room_type / "sampled" / "nodes.parquet").scene_id.nunique()
-        assert len(scenes) == min(3, sampled)  # failed scenes are recorded, never dropped
+        assert len(scenes) == min(2, sampled)  # failed scenes are recorded, never dropped
         assert set(scenes.status) <= {"placed", "failed"} and (scenes[scenes.status == "failed"].reason != "").all()
         for scene in scenes.scene_id:
             for ext in ("glb", "png", "json"):
@@ -197,6 +203,9 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
         objs = pd.read_parquet(folder / "objects.parquet")
         assert (objs.scene_id == objs.room_id).all()
         assert objs.groupby("room_id").size().reindex(scenes.scene_id, fill_value=0).tolist() == scenes.placed_objects.tolist()
+    for rel, name in (("planit/objects.parquet", "generated_objects"), ("planit/scenes.parquet", "scenes"),
+                      ("planit/rooms.parquet", "rooms"), ("heldout/models.parquet", "models")):
+        assert tables.metadata(res / "generated" / "bedroom" / rel)["pipeline.schema"] == f"{name}/v1", rel
     table = pd.read_csv(res / "generated" / "bedroom" / "table3.csv")
     assert table.variant.tolist() == ["heldout", "random_location", "unconditional", "no_pruning", "half_pruning",
                                       "no_ordering"]

@@ -16,7 +16,11 @@ GRAPHS = Path("results/graphs/ingested")
 def corpus_paths(config: dict) -> dict:
     """The kept corpus's canonical tables per shard, the symmetry and category-size tables (workflow layout)."""
     shards = range(config["shards"])
-    return {"rooms": [Path(f"results/filter/shards/rooms-{k}.parquet") for k in shards],
+    rooms = [Path(f"results/filter/shards/rooms-{k}.parquet") for k in shards]
+    if not all(p.exists() for p in rooms):
+        raise InputError(f"{rooms[0].parent}: the filter's {config['shards']} shard(s) are not all there; run the "
+                         "pipeline first, or give the config it ran with (--config; default config/config.yaml)")
+    return {"rooms": rooms,
             **{t: [Path(f"results/ingest/shards/{t}-{k}.parquet") for k in shards] for t in ("architecture", "objects", "models")},
             "symmetry": GRAPHS / "symmetry.parquet", "category_sizes": GRAPHS / "stats" / "category_sizes.parquet"}
 

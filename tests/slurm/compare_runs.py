@@ -1,4 +1,4 @@
-"""Compare two results/ folders as tables (schema and rows) and their JSON metrics.
+"""Compare two results/ folders as tables (schema and rows, wall-clock columns aside) and their JSON metrics.
 
     python tests/slurm/compare_runs.py RESULTS_A RESULTS_B              every table file, row for row
     python tests/slurm/compare_runs.py --gathered RESULTS_A RESULTS_B   only dataset-level tables, ignoring shard
@@ -26,9 +26,17 @@ def _canonical(path: Path):
     return df.sort_values(keys, na_position="first", kind="stable").reset_index(drop=True)
 
 
+TIMINGS = ("seconds",)  # wall-clock columns (instantiation's seconds per scene) differ between any two runs
+
+
+def _table(path: Path):
+    t = pq.read_table(path)
+    return t.drop_columns([c for c in TIMINGS if c in t.column_names])
+
+
 def _same(a: Path, b: Path, gathered: bool) -> bool:
     if not gathered:
-        return pq.read_table(a).equals(pq.read_table(b))
+        return _table(a).equals(_table(b))
     x, y = _canonical(a), _canonical(b)
     return list(x.columns) == list(y.columns) and x.map(repr).equals(y.map(repr))
 
