@@ -8,12 +8,16 @@ min_version("9.0")
 configfile: f"{workflow.basedir}/config/config.yaml"
 
 
+report: "report/workflow.rst"
+
+
 include: "rules/common.smk"
 include: "rules/ingest.smk"
 include: "rules/extract.smk"
 include: "rules/refine.smk"
 include: "rules/graph_model.smk"
 include: "rules/instantiate.smk"
+include: "rules/evaluate.smk"
 
 
 rule all:

@@ -332,6 +332,31 @@ def table3(summary: List[Path] = _files("--summary", "one per variant"), out: Pa
 
 
 @app.command()
+def evaluate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
+             room_type: str = typer.Option(..., "--room-type"),
+             generated: List[str] = typer.Option(..., "--generated", help="NAME=FOLDER, an instantiation output; the first is the default generator"),
+             rooms: List[Path] = _files("--rooms"), architecture: List[Path] = _files("--architecture"),
+             objects: List[Path] = _files("--objects"), models: List[Path] = _files("--models"),
+             nodes: Path = _file("--nodes", "the corpus's final nodes (the held-out split)"),
+             edges: Path = _file("--edges", "the corpus's final edges (the gallery's real graphs)"),
+             symmetry: Path = _file("--symmetry", "the corpus's symmetry table (extraction)"),
+             out_metrics: Path = _file("--out-metrics"), out_scenes: Path = _file("--out-scenes"),
+             out_table: Path = _file("--out-table", "the sets side by side (CSV)"),
+             out_gallery: Path = _file("--out-gallery", "folder of generated and real rooms (PNG, GLB)"),
+             threads: int = typer.Option(1, "--threads", help="CPU threads (the rule's threads)")) -> None:
+    """Score generated rooms, baselines and held-out real rooms of one room type with the same metrics."""
+    from .stages import evaluate as stage
+
+    pairs = [g.partition("=") for g in generated]
+    if any(not sep or not name for name, sep, _ in pairs):
+        _fail("--generated takes NAME=FOLDER")
+    m = _stage(stage.run, config, config_json, room_type, [(n, Path(f)) for n, _, f in pairs], rooms, architecture,
+               objects, models, nodes, edges, symmetry, out_metrics, out_scenes, out_table, out_gallery, threads)
+    typer.echo(" ".join(f"{name}: kl={s['category_kl']} collide={s['object_collision_rate']} "
+                        f"walk={s['walkable_share']} sca={(s.get('sca') or {}).get('mean')}" for name, s in m["sets"].items()))
+
+
+@app.command()
 def generate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
              room_type: Optional[str] = typer.Option(None, "--room-type", help="default: the spec's room_type"),
              spec: Optional[Path] = typer.Option(None, "--spec", help="complete this partial graph (YAML) first"),

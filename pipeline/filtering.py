@@ -5,6 +5,8 @@ report row names the first rule that rejected it and lists every rule it fails.
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 import pandas as pd
 
@@ -81,20 +83,25 @@ def _placement_reasons(room, objs: dict, cfg: dict) -> list[tuple[str, str]]:
     return out
 
 
-def deepest_penetration(box_depth: np.ndarray, objs: dict, cfg: dict) -> tuple[int, int, float, str] | None:
-    """The first pair, deepest box overlap first, that penetrates deeper than ``max_penetration``: measured on the
-    meshes where both objects have one (``penetration.measure: mesh``), else on the boxes. None if no pair does."""
+def penetrating_pairs(box_depth: np.ndarray, objs: dict, cfg: dict) -> Iterator[tuple[int, int, float, str]]:
+    """Pairs ``(i, j, depth, measure)``, deepest box overlap first, that penetrate deeper than ``max_penetration``:
+    measured on the meshes where both objects have one (``penetration.measure: mesh``), else on the boxes."""
     pen, limit = cfg["penetration"], cfg["max_penetration"]
     i, j = np.nonzero(np.triu(box_depth > limit, 1))
     for k in np.argsort(-box_depth[i, j], kind="stable"):
         a, b = int(i[k]), int(j[k])
         ma, mb = objs["meshes"][a], objs["meshes"][b]
         if pen["measure"] == "box" or ma is None or mb is None:
-            return a, b, float(box_depth[a, b]), "boxes"
+            yield a, b, float(box_depth[a, b]), "boxes"
+            continue
         d = mesh_penetration(_world(ma, objs["poses"][a]), _world(mb, objs["poses"][b]), cfg["intersector"], pen)
         if d > limit:
-            return a, b, d, "meshes"
-    return None
+            yield a, b, d, "meshes"
+
+
+def deepest_penetration(box_depth: np.ndarray, objs: dict, cfg: dict) -> tuple[int, int, float, str] | None:
+    """The first of :func:`penetrating_pairs` (None if no pair penetrates)."""
+    return next(penetrating_pairs(box_depth, objs, cfg), None)
 
 
 def _world(mesh: tuple[np.ndarray, np.ndarray], pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

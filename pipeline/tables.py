@@ -218,6 +218,18 @@ SCHEMAS["scenes"] = pa.schema([
     _f("unplanned_adjacent", _I32, doc="of those, support or adjacent ones"),
     _f("colliding_objects", _I32, doc="objects penetrating another deeper than instantiate.checks.collision"),
 ])
+SCHEMAS["eval_scenes"] = pa.schema([
+    _f("set", _CAT, nullable=False, doc="planit, a baseline variant, retrieval (nearest training room) or real_heldout"),
+    _f("scene_id", _STR, nullable=False, doc="generated scene or real room id"), _f("room_type", _CAT),
+    _f("objects", _I32), _f("colliding_objects", _I32, doc="objects penetrating another deeper than evaluate.collision"),
+    _f("out_of_bounds", _I32, doc="objects whose eroded footprint leaves the floor"),
+    _f("walkable_share", _F64, doc="door-connected share of the agent's free floor"),
+    _f("reachable", _F64, doc="share of floor objects whose front an agent reaches from a door"),
+    _f("nn_similarity", _F64, doc="layout similarity to the nearest training room (itself excluded)"),
+    _f("nn_room_id", _STR, doc="that training room"),
+    _f("consistency", _F64, doc="instantiation's graph consistency (null for real rooms)"),
+    _f("violation", _F64, doc="instantiation's violation cost (null for real rooms)"),
+])
 SCHEMAS["superstructures"] = pa.schema([
     _f("room_id", _STR, nullable=False), _f("room_type", _CAT),
     _f("group_id", _STR, doc="hub_<k> | chain_<k>, unique within the room"),
@@ -265,7 +277,7 @@ SCHEMAS["category_sizes"] = pa.schema([
 KEYS = {"rooms": ["room_id"], "architecture": ["room_id", "element_id"], "objects": ["room_id", "object_id"],
         "models": ["model_id"], "symmetry": ["model_id"], "nodes": ["room_id", "node_id"],
         "final_nodes": ["room_id", "node_id"], "filter_report": ["room_id"], "generated_objects": ["room_id", "object_id"],
-        "scenes": ["scene_id"], "generated_nodes": ["room_id", "node_id"]}
+        "scenes": ["scene_id"], "eval_scenes": ["set", "scene_id"], "generated_nodes": ["room_id", "node_id"]}
 # The rule that writes each kind of table: a missing or corrupt one is reported with the rule to rerun.
 PRODUCERS = {"rooms": "ingest or filter_rooms", "architecture": "ingest", "objects": "ingest", "models": "ingest",
              "ground_truth": "ingest", "ingest_report": "ingest or ingest_summary", "drops": "ingest or ingest_summary",
@@ -275,7 +287,8 @@ PRODUCERS = {"rooms": "ingest or filter_rooms", "architecture": "ingest", "objec
              "cooccurrence": "graph_statistics", "relations": "graph_statistics", "hub_patterns": "graph_statistics",
              "category_sizes": "graph_statistics", "final_nodes": "refine_graphs or gather_graphs",
              "final_edges": "refine_graphs or gather_graphs", "generated_nodes": "sample_graphs",
-             "generated_edges": "sample_graphs", "generated_objects": "instantiate", "scenes": "instantiate"}
+             "generated_edges": "sample_graphs", "generated_objects": "instantiate", "scenes": "instantiate",
+             "eval_scenes": "evaluate"}
 
 
 def _made_by(name: str | None) -> str:
@@ -466,6 +479,16 @@ def read_meshes(path: str | Path, model_ids) -> tuple[dict, set]:
     rows = read(path, "models", filters=[("model_id", "in", sorted(set(model_ids)))],
                 columns=["model_id", "vertices", "faces", "mesh_kind"]).to_pylist()
     return {m["model_id"]: model_mesh(m) for m in rows}, {m["model_id"] for m in rows if m["mesh_kind"] == "box_fallback"}
+
+
+def read_meshes_of(paths, model_ids) -> tuple[dict, set]:
+    """:func:`read_meshes` over several ``models`` tables (the shards)."""
+    meshes, box_models = {}, set()
+    for p in paths:
+        m, b = read_meshes(p, model_ids)
+        meshes.update(m)
+        box_models |= b
+    return meshes, box_models
 
 
 def model_mesh(row: dict):

@@ -2,6 +2,7 @@
 import json
 import shlex
 import sys
+from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
@@ -59,6 +60,8 @@ GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
 PLACEMENT = "results/placement/{room_type}/{net}/{name}"
 GENERATED = "results/generated/{room_type}/{variant}/{name}"
 TABLE3 = "results/generated/{room_type}/table3.csv"
+EVAL = "results/eval/{room_type}/{name}"
+EVAL_SETS = ["planit", *config["evaluate"]["baselines"]]
 VARIANTS = config["instantiate"]["variants"]
 TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldout"]
 # what placement training reads
@@ -71,6 +74,13 @@ def keys(*dotted):
     """The config keys a rule's stage reads, as JSON for `planit ... --config-json` (a rerun trigger: the rule
     reruns exactly when one of these keys changes)."""
     return json.dumps(planit_config.pick(config, dotted), sort_keys=True, separators=(",", ":"))
+
+
+def instantiate_keys(wildcards):
+    """Params function: the keys an instantiation job reads, its own variant's spec only (adding or changing another
+    variant reruns nothing here)."""
+    own = [f"instantiate.{k}" for k in config["instantiate"] if k not in ("variants", "table3_room_types")]
+    return keys("seed", "extract", "floor_contact", *own, f"instantiate.variants.{wildcards.variant}")
 
 
 def shards_of(template, **fixed):
@@ -133,6 +143,11 @@ def get_instantiate_inputs(wildcards):
     return {**graphs, "model": PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")}
 
 
+def generated_options(wildcards, input):
+    """Params function: `--generated NAME=FOLDER` for the default variant and each baseline."""
+    return " ".join(f"--generated {v}={shlex.quote(str(Path(p).parent))}" for v, p in zip(EVAL_SETS, input.summaries))
+
+
 def get_final_outputs():
     types = graph_room_types()
     return [
@@ -140,6 +155,7 @@ def get_final_outputs():
         *expand(PLACEMENT, room_type=types, net="cfcn", name="loss.png"),
         *expand(GENERATED, room_type=types, variant="planit", name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
+        *expand(EVAL, room_type=types, name="metrics.json"),
         FILTER_REPORT,
         INGEST_REPORT,
         DROPS,

@@ -9,7 +9,8 @@ rule train_graph_model:
     output:
         model=GRAPH_MODEL.replace("{name}", "model.pt"),
         history=GRAPH_MODEL.replace("{name}", "history.csv"),
-        curve=GRAPH_MODEL.replace("{name}", "loss.png"),
+        curve=report(GRAPH_MODEL.replace("{name}", "loss.png"), caption="../report/graph_model_loss.rst",
+                     category="3. Training", subcategory="graph model", labels={"room type": "{room_type}"}),
         summary=GRAPH_MODEL.replace("{name}", "training.json"),
     params:
         config=keys("seed", *(f"graph_model.{k}" for k in GRAPH_TRAIN_KEYS)),

@@ -74,7 +74,7 @@ rule filter_report:
         reports=shards_of(FILTER_SHARD_REPORT),
     output:
         report=FILTER_REPORT,
-        counts=RULE_COUNTS,
+        counts=report(RULE_COUNTS, caption="../report/filter_counts.rst", category="1. Ingest and filter"),
     params:
         reports=repeat("--report", "reports"),
     log:

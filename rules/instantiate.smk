@@ -12,7 +12,9 @@ rule train_placement:
     output:
         model=PLACEMENT.replace("{name}", "model.pt"),
         history=PLACEMENT.replace("{name}", "history.csv"),
-        curve=PLACEMENT.replace("{name}", "loss.png"),
+        curve=report(PLACEMENT.replace("{name}", "loss.png"), caption="../report/placement_loss.rst",
+                     category="3. Training", subcategory="placement networks",
+                     labels={"room type": "{room_type}", "network": "{net}"}),
         summary=PLACEMENT.replace("{name}", "training.json"),
     params:
         config=keys("seed", "graph_model.heldout_fraction", *(f"placement.{k}" for k in PLACEMENT_TRAIN_KEYS)),
@@ -53,7 +55,7 @@ rule instantiate:
         summary=GENERATED.replace("{name}", "summary.json"),
         files=directory(GENERATED.replace("{name}", "scenes")),
     params:
-        config=keys("seed", "extract", "floor_contact", "instantiate"),
+        config=instantiate_keys,
         rooms=repeat("--rooms", "rooms"),
         architecture=repeat("--architecture", "architecture"),
         objects=repeat("--objects", "objects"),
@@ -77,7 +79,8 @@ rule table3:
     input:
         summaries=expand(GENERATED, variant=TABLE3_VARIANTS, name="summary.json", allow_missing=True),
     output:
-        table=TABLE3,
+        table=report(TABLE3, caption="../report/table3.rst", category="4. Instantiation (Table 3)",
+                     labels={"room type": "{room_type}"}),
     params:
         summaries=repeat("--summary", "summaries"),
     log:

@@ -33,7 +33,8 @@ def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path 
     return proc
 
 
-GRAPH_MODEL_RULES = ("train_graph_model", "sample_graphs", "graph_model_metrics", "train_placement", "instantiate")
+GRAPH_MODEL_RULES = ("train_graph_model", "sample_graphs", "graph_model_metrics", "train_placement", "instantiate",
+                     "evaluate")
 TABLE3 = "results/generated/bedroom/table3.csv"  # tiny.yaml leaves Table 3 out of the default target
 
 
@@ -156,13 +157,13 @@ def test_forcerun_refine_reruns_only_refinement_and_after(run_dir):
 def test_a_sampling_setting_resamples_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n"
                                             "graph_model:\n  sample: {graphs: 20, batch_size: 20, temperature: 0.8}\n")
-    assert jobs == {"sample_graphs", "graph_model_metrics", "instantiate"}  # the sampled graphs are placed again
+    assert jobs == {"sample_graphs", "graph_model_metrics", "instantiate", "evaluate"}  # placed and scored again
 
 
 def test_a_search_setting_replaces_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\ninstantiate:\n  samples: 12\n",
                          "all", TABLE3)
-    assert jobs == {"instantiate", "table3"}  # the placement networks are kept
+    assert jobs == {"instantiate", "table3", "evaluate"}  # the placement networks are kept
 
 
 def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
@@ -221,6 +222,77 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
                        tmp_path / "e.parquet", tmp_path / "s.json")
     nodes = pd.read_parquet(tmp_path / "n.parquet")
     assert (nodes.kind == "object").sum() == placed
+
+
+def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
+    from pipeline.corpus.procedural_rules import RULES
+
+    res = run_dir / "results"
+    sets = {"planit", "random_sampled", "unconditional_sampled", "retrieval", "real_heldout"}
+    for room_type in ("bedroom", "living", "office", "bathroom", "kitchen"):
+        m = json.loads((res / "eval" / room_type / "metrics.json").read_text())
+        assert set(m["sets"]) == sets
+        real, gen = m["sets"]["real_heldout"], m["sets"]["planit"]
+        assert real["category_kl"] == 0.0 and real["count_distance"] == 0.0 and "sca" not in real
+        if gen["scenes"] >= 2:  # the classifier needs a generated room on each side of its split
+            assert len(gen["sca"]["runs"]) == 2 and 50.0 <= gen["sca"]["mean"] <= 100.0
+        if m["sets"]["retrieval"]["scenes"]:
+            assert m["sets"]["retrieval"]["nn_similarity"]["mean"] == 1.0  # the memorisation floor
+        assert set(m["floors"]) == {"category_kl", "count_distance"} and m["goals"]
+        assert all(set(s["rules"]) == set(RULES) for s in m["sets"].values())  # the generator's rules, re-extracted
+        rows = pd.read_parquet(res / "eval" / room_type / "scenes.parquet")
+        assert tables.metadata(res / "eval" / room_type / "scenes.parquet")["pipeline.schema"] == "eval_scenes/v1"
+        assert rows.groupby("set").size().to_dict() == {k: v["scenes"] for k, v in m["sets"].items() if v["scenes"]}
+        assert rows.walkable_share.between(0, 1).all() and rows.nn_similarity.between(0, 1).all()
+
+
+def _report(run_dir) -> Path:
+    out = run_dir / "results" / "report.html"
+    if not out.exists():
+        snakemake(run_dir, "--report", str(out), "all", TABLE3)
+    return out
+
+
+def test_the_report_gathers_counts_tables_curves_evaluation_and_gallery(run_dir):
+    import base64
+
+    html = _report(run_dir).read_text()
+    for item in ("results/filter/rule_counts.tsv", "results/graphs/ingested/report/table1.csv",
+                 "results/graphs/ingested/report/pruning.csv", "results/graph_model/bedroom/loss.png",
+                 "results/placement/bedroom/cfcn/loss.png", "results/generated/bedroom/table3.csv",
+                 "results/eval/bedroom/metrics.csv"):
+        assert f'"{item}": {{' in html, item
+    gallery = sorted((run_dir / "results" / "eval" / "bedroom" / "gallery").glob("*.png"))
+    assert any(p.name.startswith("real_") for p in gallery)
+    for png in gallery:  # each gallery image is embedded whole, as a PNG
+        entry = html[html.index(f'"results/eval/bedroom/gallery/{png.name}": {{'):]
+        data = re.search(r'"data_uri": "data:image/png;[^"]*?base64,([A-Za-z0-9+/=]+)"', entry).group(1)
+        assert base64.b64decode(data) == png.read_bytes()
+
+
+def test_the_report_renders_in_headless_chromium_and_its_gallery_images_load(run_dir, tmp_path):
+    from webdriver import CHROMEDRIVER, CHROMIUM, Browser
+
+    if not (CHROMIUM and CHROMEDRIVER):
+        pytest.skip("Debian's chromium and chromium-driver are not installed (make test installs them where it can)")
+    report = _report(run_dir)
+    browser = Browser(tmp_path / "profile")
+    try:
+        browser.open(report.as_uri())
+        browser.click_text("6. Gallery")
+        browser.click_text("bedroom")
+        shown = []
+        for k in range(len(browser.elements("tbody tr a[iconname='eye']"))):
+            browser.click(browser.elements("tbody tr a[iconname='eye']")[k])
+            shown += browser.run("return Array.from(document.images).filter(i => i.src.startsWith('data:image/png'))"
+                                 ".map(i => [i.src.split(';')[2], i.complete, i.naturalWidth])")
+        shot = browser.screenshot(tmp_path / "gallery.png")
+    finally:
+        browser.close()
+    names = sorted(p.name for p in (run_dir / "results/eval/bedroom/gallery").glob("*.png"))
+    assert sorted({s[0].removeprefix("filename=") for s in shown}) == names
+    assert all(complete and width >= 400 for _, complete, width in shown)  # decoded, at the figure's size
+    assert shot.stat().st_size > 10_000
 
 
 def test_invalid_config_names_the_key_in_one_line(tmp_path):

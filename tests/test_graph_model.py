@@ -208,7 +208,9 @@ def test_extraction_and_refinement_never_import_torch():
             "pipeline.stages.extract_graphs, pipeline.stages.refine_graphs, pipeline.cli, pipeline.learn.graph_data, "
             "pipeline.learn.graph_checks, pipeline.learn.graph_metrics, pipeline.learn.placement_data, "
             "pipeline.placement.search, pipeline.placement.checks, pipeline.placement.export, "
-            "pipeline.placement.scene_metrics, pipeline.stages.instantiate, pipeline.stages.generate; "
+            "pipeline.placement.scene_metrics, pipeline.stages.instantiate, pipeline.stages.generate, "
+            "pipeline.evaluation.distributions, pipeline.evaluation.physical, pipeline.evaluation.walkability, "
+            "pipeline.evaluation.render, pipeline.stages.evaluate; "
             "assert 'torch' not in sys.modules, 'torch'")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr

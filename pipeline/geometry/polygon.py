@@ -134,3 +134,17 @@ def poke_out(outline: np.ndarray, points: np.ndarray) -> np.ndarray:
     poly = shapely.Polygon(outline)
     pts = shapely.points(np.asarray(points, float).reshape(-1, 2))
     return np.where(shapely.covers(poly, pts), 0.0, shapely.distance(poly.exterior, pts))
+
+
+def door_zones(outline: np.ndarray, doors: np.ndarray, depth: float) -> np.ndarray:
+    """``(m, 4, 2)`` counter-clockwise rectangles reaching ``depth`` m into the room from each door segment of
+    ``doors (m, 2, 2)`` (the side whose point just off the door's midpoint lies inside ``outline (k, 2)``)."""
+    doors = np.asarray(doors, float).reshape(-1, 2, 2)
+    a, b = doors[:, 0], doors[:, 1]
+    d = b - a
+    n = np.stack([-d[:, 1], d[:, 0]], 1) / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+    probe = (a + b) / 2 + 0.05 * n
+    n = np.where((poke_out(outline, probe) > 0)[:, None], -n, n)  # flip where the left side is outside
+    quads = np.stack([a, b, b + depth * n, a + depth * n], axis=1)
+    ccw = np.cross(quads[:, 1] - quads[:, 0], quads[:, 2] - quads[:, 1]) > 0
+    return np.where(ccw[:, None, None], quads, quads[:, ::-1])

@@ -12,7 +12,7 @@ import shapely
 from ..extraction import RoomInput, extract_room
 from ..filtering import deepest_penetration
 from ..geometry import boxes
-from ..geometry.polygon import poke_out
+from ..geometry.polygon import door_zones, poke_out
 from .plan import PlanEdge
 
 
@@ -81,6 +81,17 @@ def found_edges(edges: list[dict]) -> dict:
     return out
 
 
+def blocks_door(room: RoomInput, corners: np.ndarray, depth: float) -> bool:
+    """Whether a floor footprint ``corners (4, 2)`` covers more than 1 cm^2 of the zone ``depth`` m deep inside any
+    door of the room (0: no zone)."""
+    doors = [o for o in room.openings if o["kind"] == "door"]
+    if depth <= 0 or not doors:
+        return False
+    zones = door_zones(room.outline, np.array([[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in doors]), depth)
+    overlap = shapely.area(shapely.intersection(shapely.polygons(zones), shapely.Polygon(corners)))
+    return bool((overlap > 1e-4).any())
+
+
 def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str]]:
     """Mean cost of ``planned`` edges (each between the new object and a node already in the room) on the room's
     extracted graph, and the objects at the other end of the edges not found exactly."""
@@ -103,6 +114,8 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
         poke = float(poke_out(room.outline, corners).max())
         if poke > checker.cfg["outside"]:
             return Verdict(False, f"outside the floor by {poke:.2f} m")
+        if blocks_door(room, corners, checker.cfg["door_clearance"]):
+            return Verdict(False, "blocks a door's clearance")
     elif support_share(room.boxes[k], room.boxes[parent]) < checker.cfg["min_support"]:
         return Verdict(False, "overhangs its support", culprits={room.object_ids[parent]})
     hit = collision(room, k, children | ({parent} if parent is not None else set()), checker)

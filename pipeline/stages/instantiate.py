@@ -52,11 +52,7 @@ def load_context(config: dict, room_type: str, saved: dict, rooms: list[Path], a
     held = set(saved["heldout_ids"])
     sym_rows = tables.read(symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
     sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
-    meshes, box_models = {}, set()
-    for p in models:
-        m, b = tables.read_meshes(p, objs["model_id"].dropna())
-        meshes.update(m)
-        box_models |= b
+    meshes, box_models = tables.read_meshes_of(models, objs["model_id"].dropna())
     sizes = tables.read(category_sizes, "category_sizes").to_pandas()
     sizes = sizes[sizes["room_type"].astype(str) == room_type]
     ext = {**config["extract"], "floor_contact": config["floor_contact"]}

@@ -1,0 +1,61 @@
+"""Set-level distances between two collections of rooms: category KL divergence (ATISS's definition), object-count
+distance, and their sampling floors (the same distance between two disjoint sets of real rooms)."""
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+
+def category_kl(real: Sequence[str], generated: Sequence[str], eps: float = 1e-6) -> float:
+    """KL(p || q) of the category frequencies over all objects: p from ``real``, q from ``generated`` (one category
+    label per object), ``sum p (log(p + eps) - log(q + eps))`` over the categories of both."""
+    cats = sorted(set(real) | set(generated))
+    if not cats:
+        return 0.0
+    p = _frequencies(real, cats)
+    q = _frequencies(generated, cats)
+    return float(np.sum(p * (np.log(p + eps) - np.log(q + eps))))
+
+
+def count_distance(real: Sequence[int], generated: Sequence[int]) -> float:
+    """Total variation distance (0: same, 1: disjoint) between the rooms' object-count distributions."""
+    if not len(real) or not len(generated):
+        return 1.0
+    support = sorted(set(real) | set(generated))
+    return float(0.5 * np.abs(_frequencies(real, support) - _frequencies(generated, support)).sum())
+
+
+def _frequencies(values: Sequence, support: list) -> np.ndarray:
+    counts = Counter(values)
+    total = max(sum(counts.values()), 1)
+    return np.array([counts[v] / total for v in support], dtype=float)
+
+
+def sampling_floor(pool: Sequence, sizes: tuple[int, int], distance: Callable[[list, list], float], repeats: int,
+                   seed: int) -> dict:
+    """The distance between two disjoint random sets of ``pool`` rooms of ``sizes`` (shrunk in proportion when the
+    pool is smaller than their sum), mean and sd over ``repeats`` draws. ``distance`` takes the two lists."""
+    a, b = _split_sizes(len(pool), sizes)
+    if a == 0 or b == 0:
+        return {"mean": float("nan"), "sd": float("nan"), "sizes": [a, b], "repeats": 0}
+    rng = np.random.default_rng([seed, 1414])
+    values = []
+    for _ in range(repeats):
+        perm = rng.permutation(len(pool))
+        values.append(distance([pool[i] for i in perm[:a]], [pool[i] for i in perm[a:a + b]]))
+    return {"mean": float(np.mean(values)), "sd": float(np.std(values)), "sizes": [a, b], "repeats": repeats}
+
+
+def _split_sizes(n: int, sizes: tuple[int, int]) -> tuple[int, int]:
+    a, b = sizes
+    if a + b <= n:
+        return a, b
+    a2 = int(n * a / max(a + b, 1))
+    return a2, n - a2
+
+
+def flatten(rooms: Sequence[Sequence[str]]) -> list[str]:
+    """One category label per object over rooms given as category lists."""
+    return [c for room in rooms for c in room]
