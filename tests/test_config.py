@@ -117,3 +117,12 @@ def test_environment_yml_matches_pyproject():
         if m and m.group(1) != "python":
             conda[_norm(m.group(1))] = ("==" if m.group(2) == "=" else ">=", m.group(3))
     assert conda == pins
+
+
+@pytest.mark.parametrize("name", ["tiny", "front3d", "ithor", "paper"])
+def test_every_shipped_config_validates_over_the_defaults(name):
+    cfg = config.load(ROOT / "config" / f"{name}.yaml")
+    assert cfg["seed"] is not None and cfg["evaluate"]["sca"]["runs"] >= 1
+    if name == "paper":
+        assert cfg["graph_model"]["preset"] == cfg["placement"]["preset"] == "paper"
+        assert cfg["placement"]["presets"]["paper"]["size"] == 256
