@@ -146,5 +146,6 @@ def door_zones(outline: np.ndarray, doors: np.ndarray, depth: float) -> np.ndarr
     probe = (a + b) / 2 + 0.05 * n
     n = np.where((poke_out(outline, probe) > 0)[:, None], -n, n)  # flip where the left side is outside
     quads = np.stack([a, b, b + depth * n, a + depth * n], axis=1)
-    ccw = np.cross(quads[:, 1] - quads[:, 0], quads[:, 2] - quads[:, 1]) > 0
+    u, v = quads[:, 1] - quads[:, 0], quads[:, 2] - quads[:, 1]
+    ccw = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0] > 0
     return np.where(ccw[:, None, None], quads, quads[:, ::-1])
