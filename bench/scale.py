@@ -7,12 +7,12 @@ resident memory come from Snakemake's own benchmark files (``benchmarks/<rule>/*
 """
 from __future__ import annotations
 
-import csv
 import subprocess
 import sys
 import time
-from collections import defaultdict
 from pathlib import Path
+
+from pipeline.stages import runtime
 
 from common import ROOT, arguments, report
 
@@ -37,16 +37,11 @@ def main() -> None:
     subprocess.run([str(Path(sys.executable).parent / "snakemake"), "--snakefile", str(ROOT / "Snakefile"), "-d", str(work),
                     "--configfile", str(cfg), "--cores", str(args.cores), "-q"], check=True)
     wall = time.perf_counter() - t0
-    seconds, rss = defaultdict(float), defaultdict(float)
-    for tsv in (work / "benchmarks").rglob("*.tsv"):
-        rule = tsv.parent.name
-        row = next(csv.DictReader(tsv.open(), delimiter="\t"))
-        seconds[rule] += float(row["s"])
-        rss[rule] = max(rss[rule], float(row["max_rss"]) if row["max_rss"] not in ("", "NA", "-") else 0.0)
+    rules = runtime.per_rule(runtime.read_benchmarks(work / "benchmarks")).iloc[2:]  # per rule, summary rows aside
     result = {"rooms": sum(rooms.values()), "shards": args.shards, "cores": args.cores, "wall_seconds": round(wall, 1),
-              "job_seconds_per_rule": {k: round(v, 1) for k, v in sorted(seconds.items())},
-              "peak_rss_mb_per_rule": {k: round(v) for k, v in sorted(rss.items())},
-              "peak_rss_mb": round(max(rss.values(), default=0.0))}
+              "job_seconds_per_rule": dict(zip(rules.rule, rules.job_seconds)),
+              "peak_rss_mb_per_rule": dict(zip(rules.rule, rules.peak_rss_mb)),
+              "peak_rss_mb": float(rules.peak_rss_mb.max()) if len(rules) else 0.0}
     report(result, args.workdir, f"scale-{args.rooms}")
 
 

@@ -357,6 +357,15 @@ def evaluate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = Js
 
 
 @app.command()
+def runtime(benchmarks: Path = typer.Option(Path("benchmarks"), "--benchmarks", help="Snakemake's benchmark folder"),
+            out: Path = _file("--out", "runtime.csv")) -> None:
+    """Job seconds and peak memory per rule from the benchmark files, and the run's wall-clock span (CSV)."""
+    from .stages import runtime as stage
+
+    typer.echo(_guard(stage.run, benchmarks, out).to_string(index=False))
+
+
+@app.command()
 def generate(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
              room_type: Optional[str] = typer.Option(None, "--room-type", help="default: the spec's room_type"),
              spec: Optional[Path] = typer.Option(None, "--spec", help="complete this partial graph (YAML) first"),

@@ -61,6 +61,7 @@ PLACEMENT = "results/placement/{room_type}/{net}/{name}"
 GENERATED = "results/generated/{room_type}/{variant}/{name}"
 TABLE3 = "results/generated/{room_type}/table3.csv"
 EVAL = "results/eval/{room_type}/{name}"
+RUNTIME = "results/runtime.csv"
 EVAL_SETS = ["planit", *config["evaluate"]["baselines"]]
 VARIANTS = config["instantiate"]["variants"]
 TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldout"]
@@ -149,6 +150,11 @@ def generated_options(wildcards, input):
 
 
 def get_final_outputs():
+    """Every output of the default run; the run-time table last, built once all the others exist."""
+    return [*pipeline_outputs(), RUNTIME]
+
+
+def pipeline_outputs():
     types = graph_room_types()
     return [
         *expand(GRAPH_MODEL, room_type=types, name=["metrics.json", "loss.png"]),

@@ -40,3 +40,16 @@ rule evaluate:
         "--symmetry {input.symmetry} "
         "--out-metrics {output.metrics} --out-scenes {output.scenes} --out-table {output.table} "
         "--out-gallery {output.gallery} --threads {threads} 2> {log}"
+
+
+rule runtime:
+    input:
+        pipeline_outputs(),
+    output:
+        table=report(RUNTIME, caption="../report/runtime.rst", category="7. Run time"),
+    log:
+        "logs/runtime/runtime.log",
+    conda:
+        ENV
+    shell:
+        "planit runtime --benchmarks benchmarks --out {output.table} 2> {log}"

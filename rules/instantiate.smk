@@ -85,6 +85,8 @@ rule table3:
         summaries=repeat("--summary", "summaries"),
     log:
         "logs/table3/{room_type}.log",
+    benchmark:
+        "benchmarks/table3/{room_type}.tsv"
     conda:
         ENV
     shell:

@@ -34,7 +34,7 @@ def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path 
 
 
 GRAPH_MODEL_RULES = ("train_graph_model", "sample_graphs", "graph_model_metrics", "train_placement", "instantiate",
-                     "evaluate")
+                     "evaluate", "runtime")
 TABLE3 = "results/generated/bedroom/table3.csv"  # tiny.yaml leaves Table 3 out of the default target
 
 
@@ -157,13 +157,13 @@ def test_forcerun_refine_reruns_only_refinement_and_after(run_dir):
 def test_a_sampling_setting_resamples_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n"
                                             "graph_model:\n  sample: {graphs: 20, batch_size: 20, temperature: 0.8}\n")
-    assert jobs == {"sample_graphs", "graph_model_metrics", "instantiate", "evaluate"}  # placed and scored again
+    assert jobs == {"sample_graphs", "graph_model_metrics", "instantiate", "evaluate", "runtime"}  # placed, scored again
 
 
 def test_a_search_setting_replaces_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\ninstantiate:\n  samples: 12\n",
                          "all", TABLE3)
-    assert jobs == {"instantiate", "table3", "evaluate"}  # the placement networks are kept
+    assert jobs == {"instantiate", "table3", "evaluate", "runtime"}  # the placement networks are kept
 
 
 def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
@@ -246,6 +246,18 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
         assert rows.walkable_share.between(0, 1).all() and rows.nn_similarity.between(0, 1).all()
 
 
+def test_the_run_time_table_holds_every_benchmarked_job(run_dir):
+    from pipeline.stages.runtime import TOTAL, WALL
+
+    table = pd.read_csv(run_dir / "results" / "runtime.csv").set_index("rule")
+    jobs = list((run_dir / "benchmarks").glob("*/*.tsv"))
+    rules = {p.parent.name for p in jobs} - {"table3"}  # Table 3 is built after the default target, in a second run
+    assert rules <= set(table.index) and {"ingest", "train_placement", "instantiate", "evaluate"} <= rules
+    assert table.loc[TOTAL, "jobs"] == sum(p.parent.name != "table3" for p in jobs)
+    wall, total = table.loc[WALL, "job_seconds"], table.loc[TOTAL, "job_seconds"]
+    assert 0 < wall and total / 2 - 1 <= wall  # two cores: the span is at least half the job time
+
+
 def _report(run_dir) -> Path:
     out = run_dir / "results" / "report.html"
     if not out.exists():
@@ -260,7 +272,7 @@ def test_the_report_gathers_counts_tables_curves_evaluation_and_gallery(run_dir)
     for item in ("results/filter/rule_counts.tsv", "results/graphs/ingested/report/table1.csv",
                  "results/graphs/ingested/report/pruning.csv", "results/graph_model/bedroom/loss.png",
                  "results/placement/bedroom/cfcn/loss.png", "results/generated/bedroom/table3.csv",
-                 "results/eval/bedroom/metrics.csv"):
+                 "results/eval/bedroom/metrics.csv", "results/runtime.csv"):
         assert f'"{item}": {{' in html, item
     gallery = sorted((run_dir / "results" / "eval" / "bedroom" / "gallery").glob("*.png"))
     assert any(p.name.startswith("real_") for p in gallery)

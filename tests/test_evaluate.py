@@ -2,6 +2,8 @@
 classifier on trivially separable and on identical inputs. Real Embree, real meshes, no mocks."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
@@ -195,3 +197,22 @@ def test_generator_rules_read_an_extracted_room():
     near, far = bedroom(3.0), bedroom(2.2)
     assert near["against_wall"]["share"] == 1.0 and near["small_things_on_surfaces"]["share"] == 1.0
     assert far["against_wall"]["share"] == 0.0
+
+
+def test_run_time_gathers_benchmarks_per_rule_and_the_wall_clock_span(tmp_path):
+    from pipeline.stages import runtime
+
+    header = "s\th:m:s\tmax_rss\tmax_vms\n"
+    for rule, job, seconds, rss, end in [("train", "bedroom", 10.0, "300.5", 1000), ("ingest", "0", 5.0, "120", 1020),
+                                         ("ingest", "1", 3.0, "NA", 1003)]:
+        (tmp_path / rule).mkdir(exist_ok=True)
+        tsv = tmp_path / rule / f"{job}.tsv"
+        tsv.write_text(header + f"{seconds}\t0:00:00\t{rss}\t1\n")
+        os.utime(tsv, (end, end))
+    table = runtime.run(tmp_path, tmp_path / "out" / "runtime.csv")
+    rows = table.set_index("rule")
+    assert rows.loc[runtime.WALL, "job_seconds"] == 30.0  # first start 990 (train), last end 1020
+    assert rows.loc[runtime.TOTAL, "job_seconds"] == 18.0 and rows.loc[runtime.TOTAL, "jobs"] == 3
+    assert rows.loc["ingest"].tolist()[:3] == [2, 8.0, 120.0] and table.rule.tolist()[2:] == ["train", "ingest"]
+    assert rows.loc["train", "share"] == pytest.approx(10 / 18, abs=1e-3)
+    assert (tmp_path / "out" / "runtime.csv").read_text().splitlines()[0] == "rule,jobs,job_seconds,peak_rss_mb,share"

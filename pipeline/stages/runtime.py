@@ -1,0 +1,53 @@
+"""Run time of the pipeline (report): Snakemake's benchmark files (``benchmarks/<rule>/<job>.tsv``) gathered per
+rule, and the wall-clock span from the first recorded job's start to the last one's end."""
+from __future__ import annotations
+
+import csv
+import logging
+from pathlib import Path
+
+import pandas as pd
+
+from .. import tables
+
+log = logging.getLogger("planit.runtime")
+
+WALL, TOTAL = "(wall clock: first job start to last job end)", "(all jobs)"
+
+
+def read_benchmarks(folder: Path) -> pd.DataFrame:
+    """One row per benchmarked job: ``rule``, ``job``, ``seconds``, ``max_rss_mb``, ``end`` (the file's modification
+    time, written when the job ended; POSIX seconds). Empty when ``folder`` holds none."""
+    rows = []
+    for tsv in sorted(Path(folder).glob("*/*.tsv")):
+        with tsv.open() as f:
+            row = next(csv.DictReader(f, delimiter="\t"), None)
+        if row is None:
+            continue
+        rss = row.get("max_rss", "")
+        rows.append({"rule": tsv.parent.name, "job": tsv.stem, "seconds": float(row["s"]),
+                     "max_rss_mb": float(rss) if rss not in ("", "NA", "-") else 0.0, "end": tsv.stat().st_mtime})
+    return pd.DataFrame(rows, columns=["rule", "job", "seconds", "max_rss_mb", "end"])
+
+
+def per_rule(jobs: pd.DataFrame) -> pd.DataFrame:
+    """Jobs, job seconds, share of all job seconds and peak memory per rule (slowest first), then the total and the
+    wall-clock span as two summary rows."""
+    g = jobs.groupby("rule").agg(jobs=("job", "size"), job_seconds=("seconds", "sum"), peak_rss_mb=("max_rss_mb", "max"))
+    g = g.sort_values("job_seconds", ascending=False).reset_index()
+    total = float(g.job_seconds.sum())
+    span = float(jobs.end.max() - (jobs.end - jobs.seconds).min()) if len(jobs) else 0.0
+    summary = pd.DataFrame({"rule": [WALL, TOTAL], "jobs": [len(jobs)] * 2, "job_seconds": [span, total],
+                            "peak_rss_mb": [g.peak_rss_mb.max() if len(g) else 0.0] * 2})
+    out = pd.concat([summary, g], ignore_index=True)
+    out["share"] = out.job_seconds / max(total, 1e-9)
+    out.loc[0, "share"] = float("nan")
+    return out.round({"job_seconds": 1, "peak_rss_mb": 0, "share": 3})
+
+
+def run(benchmarks: Path, out: Path) -> pd.DataFrame:
+    table = per_rule(read_benchmarks(benchmarks))
+    tables.write_csv(out, table)
+    for row in table.head(8).itertuples(index=False):
+        log.info("  %-48s %4d jobs %8.1f s", row.rule, row.jobs, row.job_seconds)
+    return table
