@@ -126,3 +126,15 @@ def test_every_shipped_config_validates_over_the_defaults(name):
     if name == "paper":
         assert cfg["graph_model"]["preset"] == cfg["placement"]["preset"] == "paper"
         assert cfg["placement"]["presets"]["paper"]["size"] == 256
+
+
+def test_default_run_places_100_rooms_per_type_and_caps_the_baselines_at_30():
+    from pipeline.stages.instantiate import scene_count
+
+    ic = config.load(ROOT / "config" / "config.yaml")["instantiate"]
+    counts = {name: scene_count(ic, v) for name, v in ic["variants"].items()}
+    assert counts["planit"] == 100
+    assert counts["random_sampled"] == counts["unconditional_sampled"] == 30
+    assert counts["heldout"] == ic["table3_scenes"] == 20
+    tiny = config.load(ROOT / "config" / "tiny.yaml")["instantiate"]
+    assert {scene_count(tiny, v) for v in tiny["variants"].values()} == {2}  # the cap never raises a count

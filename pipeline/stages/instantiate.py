@@ -130,10 +130,18 @@ def select_plans(config: dict, variant: dict, ctx: Context, nodes: Path, edges: 
     return plans_from_tables(node_df, edge_df, variant["pruning"], config["seed"])[:count]
 
 
+def scene_count(ic: dict, variant: dict) -> int:
+    """Scenes a variant places: ``scenes`` for sampled graphs, ``table3_scenes`` for held-out ones, capped by the
+    variant's own ``scenes`` (``ic``: the ``instantiate`` config section)."""
+    n = ic["scenes"] if variant["graphs"] == "sampled" else ic["table3_scenes"]
+    return min(n, variant.get("scenes", n))
+
+
 def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Path, model: Path, rooms: list[Path],
         architecture: list[Path], objects: list[Path], models: list[Path], symmetry: Path, category_sizes: Path,
         out_folder: Path, count: int | None = None, threads: int = 1) -> dict:
-    """Place ``count`` scenes (default ``instantiate.scenes``, or ``table3_scenes`` for held-out graphs) with
+    """Place ``count`` scenes (default ``instantiate.scenes`` for sampled graphs, ``table3_scenes`` for held-out ones,
+    at most the variant's own ``scenes``) with
     ``threads`` CPU threads for the networks (more than the job's cores oversubscribe them: 4x slower)."""
     import torch
 
@@ -144,7 +152,7 @@ def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Pat
     variant = ic["variants"][variant_name]
     saved = torch.load(model, map_location="cpu", weights_only=False)
     ctx = load_context(config, room_type, saved, rooms, architecture, objects, models, symmetry, category_sizes)
-    n = count or (ic["scenes"] if variant["graphs"] == "sampled" else ic["table3_scenes"])
+    n = count or scene_count(ic, variant)
     plans = select_plans(config, variant, ctx, nodes, edges, n)
     if not plans:
         log.warning("%s: no graph of room type '%s' to instantiate: writing empty tables", nodes, room_type)
