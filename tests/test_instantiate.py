@@ -140,10 +140,10 @@ def test_an_l_shaped_room_keeps_furniture_inside_its_outline():
     out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 3)
     assert out.ok, out.reason
     from pipeline.geometry.boxes import footprint_corners
-    from pipeline.geometry.polygon import poke_out
+    from pipeline.geometry.polygon import outside_area
 
     corners = footprint_corners(*out.room.boxes[:, [0, 1, 3, 4, 6]].T)
-    assert poke_out(np.array(outline, float), corners.reshape(-1, 2)).max() <= ic["checks"]["outside"]
+    assert (outside_area(np.array(outline, float), corners, ic["checks"]["outside"]) <= 1e-4).all()
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
 
 
@@ -257,3 +257,24 @@ def test_a_floor_object_may_not_stand_in_a_doors_clearance_zone():
     assert not blocks_door(room, box(3.1, 1.0), 0.6)    # past the zone
     assert not blocks_door(room, box(1.0, 3.0), 0.6)    # in the other arm
     assert not blocks_door(room, box(3.1, 1.6), 0.0)    # zone switched off
+
+
+def test_a_reflex_corner_piercing_a_footprint_is_out_of_bounds_for_the_check_and_the_evaluation():
+    """A square table turned 45 degrees over an L-shaped room's inner corner: all four footprint corners stand on the
+    floor, yet the wall corner cuts into it (a generated kitchen did this before the check shared the evaluation's
+    predicate). The same table away from the corner passes both."""
+    from pipeline.evaluation.physical import out_of_bounds
+    from pipeline.placement.checks import check
+
+    outline = [(0, 0), (4.2, 0), (4.2, 4.7), (1.4, 4.7), (1.4, 3.0), (0, 3.0)]
+    room, walls, catalog, checker, ic = setup(["desk"], outline)
+    verdicts, flags = [], []
+    for x, y in ((1.85, 2.99), (2.8, 1.5)):
+        r = Room(outline)
+        r.add("t", "desk", (1.0, 1.0, 0.7), (x, y), yaw_deg=45.0)
+        placed = r.room_input()
+        verdicts.append(check(placed, 0, None, set(), [], 0.0, checker))
+        flags.append(bool(out_of_bounds(np.array(outline, float), placed.boxes, 0.1, 1e-5)[0]))
+    assert not verdicts[0].ok and verdicts[0].reason.startswith("outside the floor"), verdicts[0].reason
+    assert flags == [True, False]
+    assert verdicts[1].ok, verdicts[1].reason

@@ -5,11 +5,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import shapely
 
 from ..extraction import RoomInput
 from ..filtering import penetrating_pairs
 from ..geometry import boxes
+from ..geometry.polygon import outside_area
 
 
 def colliding(room: RoomInput, parents: Sequence[str | None], meshes: Sequence, cfg: dict) -> np.ndarray:
@@ -37,6 +37,4 @@ def out_of_bounds(outline: np.ndarray, box: np.ndarray, erode: float, tolerance:
     if not len(box):
         return np.zeros(0, bool)
     corners = boxes.footprint_corners(box[:, 0], box[:, 1], box[:, 3], box[:, 4], box[:, 6])
-    eroded = shapely.buffer(shapely.polygons(corners), -erode, join_style="mitre")
-    outside = shapely.area(shapely.difference(eroded, shapely.Polygon(outline)))
-    return outside > tolerance
+    return outside_area(outline, corners, erode) > tolerance

@@ -136,6 +136,16 @@ def poke_out(outline: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.where(shapely.covers(poly, pts), 0.0, shapely.distance(poly.exterior, pts))
 
 
+def outside_area(outline: np.ndarray, corners: np.ndarray, erode: float) -> np.ndarray:
+    """``(n,)`` m^2 of each footprint ``corners (n, 4, 2)``, eroded by ``erode`` m (mitred), that lies outside the
+    polygon ``outline (k, 2)``. Unlike a test of the corners, it sees a reflex wall corner that pierces a footprint
+    whose corners all stand on the floor."""
+    import shapely
+
+    eroded = shapely.buffer(shapely.polygons(np.asarray(corners, float)), -erode, join_style="mitre")
+    return shapely.area(shapely.difference(eroded, shapely.Polygon(outline)))
+
+
 def door_zones(outline: np.ndarray, doors: np.ndarray, depth: float) -> np.ndarray:
     """``(m, 4, 2)`` counter-clockwise rectangles reaching ``depth`` m into the room from each door segment of
     ``doors (m, 2, 2)`` (the side whose point just off the door's midpoint lies inside ``outline (k, 2)``)."""

@@ -12,8 +12,10 @@ import shapely
 from ..extraction import RoomInput, extract_room
 from ..filtering import deepest_penetration
 from ..geometry import boxes
-from ..geometry.polygon import door_zones, poke_out
+from ..geometry.polygon import door_zones, outside_area
 from .plan import PlanEdge
+
+AREA_EPS = 1e-4  # m^2: overlaps of polygons under 1 cm^2 are numerical
 
 
 @dataclass
@@ -89,7 +91,7 @@ def blocks_door(room: RoomInput, corners: np.ndarray, depth: float) -> bool:
         return False
     zones = door_zones(room.outline, np.array([[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in doors]), depth)
     overlap = shapely.area(shapely.intersection(shapely.polygons(zones), shapely.Polygon(corners)))
-    return bool((overlap > 1e-4).any())
+    return bool((overlap > AREA_EPS).any())
 
 
 def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str]]:
@@ -111,9 +113,9 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
     me = room.object_ids[k]
     corners = boxes.footprint_corners(*room.boxes[k, [0, 1, 3, 4, 6]])[0]
     if parent is None:
-        poke = float(poke_out(room.outline, corners).max())
-        if poke > checker.cfg["outside"]:
-            return Verdict(False, f"outside the floor by {poke:.2f} m")
+        outside = float(outside_area(room.outline, corners[None], checker.cfg["outside"])[0])
+        if outside > AREA_EPS:  # the evaluation's out-of-bounds test, with the check's own margin
+            return Verdict(False, f"outside the floor ({outside * 1e4:.0f} cm^2 beyond a {checker.cfg['outside']} m margin)")
         if blocks_door(room, corners, checker.cfg["door_clearance"]):
             return Verdict(False, "blocks a door's clearance")
     elif support_share(room.boxes[k], room.boxes[parent]) < checker.cfg["min_support"]:
