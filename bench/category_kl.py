@@ -80,7 +80,8 @@ def main() -> None:
     ap.add_argument("--room-types", nargs="*", default=None)
     args = ap.parse_args()
     cfg = config_mod.load(ROOT / "config" / "config.yaml")
-    types = args.room_types or cfg["graph_model"]["room_types"]
+    types = args.room_types or cfg["graph_model"]["room_types"] or sorted(
+        p.parent.name for p in (args.run / "results" / "graph_model").glob("*/model.pt"))
     with tempfile.TemporaryDirectory() as tmp:
         result = {"graphs_per_type": args.graphs, "run": str(args.run.resolve()),
                   "room_types": {t: one_type(cfg, args.run, t, args.graphs, Path(tmp)) for t in types}}
