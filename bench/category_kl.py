@@ -7,8 +7,8 @@ Reads a finished default run under ``--run`` (its trained graph models, final gr
 and, when present, results/eval/<type>/metrics.json). Placing 1,000 rooms per type would take hours on this
 machine, so the 1,000 rooms are the graph model's sampled graphs: a placed room holds exactly its graph's objects
 (a scene places all of them or fails), so its category counts are its graph's. What that leaves out, the choice of
-which graphs the search manages to place, is measured on the run's own 100 placed rooms per type: the KL of those
-against the KL of the first 100 sampled graphs. The held-out real rooms (p) and the KL (1e-6 smoothing) are those
+which graphs the search manages to place, is measured on the run's own rooms: the KL of the sampled graphs its
+default variant tried against the KL of the rooms it placed. The held-out real rooms (p) and the KL (1e-6 smoothing) are those
 of ``planit evaluate``; the floor is the same KL between two disjoint sets of real rooms of the held-out size and
 as many as the pool leaves for the other (a pool of ~400 rooms per type cannot give 1,000).
 """
@@ -38,9 +38,15 @@ def sampled_categories(cfg: dict, run: Path, room_type: str, graphs: int, tmp: P
     summary = sample_graphs.run(cfg, room_type, run / "results" / "graph_model" / room_type / "model.pt",
                                 g / "nodes.parquet", g / "edges.parquet", out / "nodes.parquet", out / "edges.parquet",
                                 out / "summary.json", count=graphs)
-    nodes = tables.read(out / "nodes.parquet", "generated_nodes").to_pandas()
-    nodes = nodes[nodes["kind"].astype(str) == "object"]  # walls, doors and windows are architecture
-    return [grp["category"].astype(str).tolist() for _, grp in nodes.groupby("room_id", sort=False)], summary
+    return graph_categories(out / "nodes.parquet"), summary
+
+
+def graph_categories(nodes: Path, rooms: set[str] | None = None) -> list[list[str]]:
+    """Per sampled graph in ``nodes`` (of those in ``rooms``, default all): its object nodes' categories (walls,
+    doors and windows are architecture)."""
+    df = tables.read(nodes, "generated_nodes").to_pandas()
+    keep = (df["kind"].astype(str) == "object") & (df["room_id"].isin(rooms) if rooms is not None else True)
+    return [g["category"].astype(str).tolist() for _, g in df[keep].groupby("room_id", sort=False)]
 
 
 def one_type(cfg: dict, run: Path, room_type: str, graphs: int, tmp: Path) -> dict:
@@ -53,8 +59,9 @@ def one_type(cfg: dict, run: Path, room_type: str, graphs: int, tmp: Path) -> di
     rooms, summary = sampled_categories(cfg, run, room_type, graphs, tmp)
     kl = lambda rs: round(distributions.category_kl(p, distributions.flatten(rs), eps), 5)
     floor = evaluate.floors(train, real, len(rooms), cfg["evaluate"], cfg["seed"])["category_kl"]
-    out = {"heldout_rooms": len(real.rooms), "sampled_graphs": len(rooms), "category_kl": kl(rooms), "floor": floor,
-           "goal_kl_le_0.01": kl(rooms) <= 0.01, "sampler": {k: summary[k] for k in ("written", "failed_after_budget")}}
+    value = kl(rooms)
+    out = {"heldout_rooms": len(real.rooms), "sampled_graphs": len(rooms), "category_kl": value, "floor": floor,
+           "goal_kl_le_0.01": value <= 0.01, "sampler": {k: summary[k] for k in ("written", "failed_after_budget")}}
     metrics = run / "results" / "eval" / room_type / "metrics.json"
     if metrics.exists():  # the run's own graphs: every one the search tried, and the rooms it placed
         placed = json.loads(metrics.read_text())["sets"]["planit"]
@@ -66,11 +73,10 @@ def one_type(cfg: dict, run: Path, room_type: str, graphs: int, tmp: Path) -> di
 
 def run_graphs(run: Path, room_type: str) -> list[list[str]]:
     """Object categories of the sampled graphs the run's default variant tried to place."""
-    scenes = tables.read(run / "results" / "generated" / room_type / "planit" / "scenes.parquet", "scenes").to_pandas()
-    nodes = tables.read(run / "results" / "graph_model" / room_type / "sampled" / "nodes.parquet",
-                        "generated_nodes").to_pandas()
-    nodes = nodes[(nodes["kind"].astype(str) == "object") & nodes["room_id"].isin(set(scenes["scene_id"]))]
-    return [g["category"].astype(str).tolist() for _, g in nodes.groupby("room_id", sort=False)]
+    scenes = tables.read(run / "results" / "generated" / room_type / "planit" / "scenes.parquet", "scenes",
+                         columns=["scene_id"])
+    return graph_categories(run / "results" / "graph_model" / room_type / "sampled" / "nodes.parquet",
+                            set(scenes.column("scene_id").to_pylist()))
 
 
 def main() -> None:
