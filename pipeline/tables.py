@@ -420,9 +420,15 @@ def write_csv(path: str | Path, frame) -> Path:
 
 
 def write_figure(path: str | Path, figure, **savefig) -> Path:
-    """A matplotlib figure, written atomically (the format follows ``path``'s suffix)."""
+    """A matplotlib figure, written atomically (the format follows ``path``'s suffix), then closed: pyplot keeps
+    every figure it made alive until then, so a stage writing hundreds would grow without bound."""
+    import matplotlib.pyplot as plt
+
     fmt = Path(path).suffix.lstrip(".") or "png"
-    return _atomic(Path(path), lambda tmp: figure.savefig(tmp, format=fmt, **savefig))
+    try:
+        return _atomic(Path(path), lambda tmp: figure.savefig(tmp, format=fmt, **savefig))
+    finally:
+        plt.close(figure)
 
 
 def read(path: str | Path, name: str | None = None, filters=None, columns: list[str] | None = None) -> pa.Table:

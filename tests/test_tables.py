@@ -51,3 +51,18 @@ def test_read_errors_name_file_and_field(tmp_path):
     pq.write_table(pa.table({"room_id": ["r"], "element_id": ["w"]}), partial)
     with pytest.raises(tables.TableError, match=r"partial.parquet: table 'architecture' lacks field\(s\) kind"):
         tables.read(partial, "architecture")
+
+
+def test_a_written_figure_is_closed_even_when_the_write_fails(tmp_path):
+    """The instantiation writes one figure per generated room: each must be released, or hundreds pile up in pyplot."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+    tables.write_figure(tmp_path / "a.png", plt.subplots()[0])
+    assert (tmp_path / "a.png").stat().st_size > 0 and plt.get_fignums() == []
+    with pytest.raises(ValueError):
+        tables.write_figure(tmp_path / "b.unknown_format", plt.subplots()[0])
+    assert plt.get_fignums() == [] and sorted(os.listdir(tmp_path)) == ["a.png"]

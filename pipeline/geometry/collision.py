@@ -36,21 +36,30 @@ def grid(lo: np.ndarray, hi: np.ndarray, resolution: int, min_pitch: float, max_
     return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1), pitch
 
 
-def inside(scene: RoomScene, points: np.ndarray, owners: int) -> np.ndarray:
-    """``(n, owners)`` bool: each point inside each owner's mesh, by the parity of the crossings of a ray in each
-    of :data:`DIRECTIONS`; the majority of the three decides."""
-    n = len(points)
-    odd = np.zeros((n, owners), dtype=np.int64)
-    for d in DIRECTIONS:
-        crossings = np.zeros((n, owners), dtype=np.int64)
+def crossings_odd(scene: RoomScene, points: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """``(n,)`` bool: whether a ray from each point along ``direction (3,)`` crosses the scene's faces an odd
+    number of times."""
+    crossings = np.zeros(len(points), dtype=np.int64)
 
-        def count(ray, owner, layer, face):  # every hit is refused, so the scene steps through them all
-            np.add.at(crossings, (ray, owner), 1)
-            return np.zeros(len(ray), dtype=bool)
+    def count(ray, owner, layer, face):  # every hit is refused, so the scene steps through them all
+        crossings[:] += np.bincount(ray, minlength=len(points))
+        return np.zeros(len(ray), dtype=bool)
 
-        scene.first_accepted(points, np.broadcast_to(d, points.shape), count, max_steps=1024)
-        odd += crossings % 2
-    return odd >= 2
+    scene.first_accepted(points, np.broadcast_to(direction, points.shape), count, max_steps=1024)
+    return crossings % 2 == 1
+
+
+def inside(mesh: tuple[np.ndarray, np.ndarray], points: np.ndarray, intersector) -> np.ndarray:
+    """``(n,)`` bool: each point inside the mesh ``(vertices (v, 3), faces (f, 3))``, by the parity of the crossings
+    of a ray in each of :data:`DIRECTIONS`, the majority of the three deciding (the third ray is cast only where
+    the first two disagree)."""
+    scene = RoomScene([mesh], np.array([0]), np.array([0]), intersector)
+    first, second = (crossings_odd(scene, points, d) for d in DIRECTIONS[:2])
+    out = first & second
+    split = np.flatnonzero(first != second)
+    if len(split):
+        out[split] = crossings_odd(scene, points[split], DIRECTIONS[2])
+    return out
 
 
 def thickness(mask: np.ndarray, pitch: float) -> float:
@@ -68,6 +77,7 @@ def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.n
     if np.any(hi <= lo):
         return 0.0
     cells, pitch = grid(lo, hi, cfg["resolution"], cfg["min_pitch"], cfg["max_cells"])
-    scene = RoomScene([a, b], np.array([0, 1]), np.array([0, 0]), intersector)
-    both = inside(scene, cells.reshape(-1, 3), 2).all(axis=1).reshape(cells.shape[:3])
-    return thickness(both, pitch)
+    points = cells.reshape(-1, 3)
+    both = inside(a, points, intersector)
+    both[both] = inside(b, points[both], intersector)  # only the points inside the first mesh can be in both
+    return thickness(both.reshape(cells.shape[:3]), pitch)

@@ -105,7 +105,6 @@ def write_report(report: dict[str, pd.DataFrame], outputs: dict[str, Path]) -> l
     ax2.legend(fontsize=7, bbox_to_anchor=(1.0, 1.0), loc="upper left")
     fig.tight_layout()
     tables.write_figure(outputs["plot"], fig, dpi=110)
-    plt.close(fig)
     return [Path(outputs[k]) for k in (*report, "plot")]
 
 

@@ -42,10 +42,11 @@ class ScenePlan:
         return self.ids.index(node_id)
 
 
-def plans_from_tables(nodes: pd.DataFrame, edges: pd.DataFrame, pruning: str = "full", seed: int = 0) -> list[ScenePlan]:
-    """One plan per scene of a graph table pair (generated tables: per ``scene_id``; final tables: per room).
-    ``pruning``: full (kept edges), none (pruned spatial edges too: the paper's no-pruning ablation) or half (a
-    seeded half of the pruned ones)."""
+def plans_from_tables(nodes: pd.DataFrame, edges: pd.DataFrame, pruning: str = "full", seed: int = 0,
+                      limit: int | None = None) -> list[ScenePlan]:
+    """One plan per scene of a graph table pair (generated tables: per ``scene_id``; final tables: per room), the
+    first ``limit`` scenes only when given. ``pruning``: full (kept edges), none (pruned spatial edges too: the
+    paper's no-pruning ablation) or half (a seeded half of the pruned ones, drawn over the whole table)."""
     scene_col = "scene_id" if "scene_id" in nodes.columns else "room_id"
     rng = np.random.default_rng([seed, 31])
     status = edges["status"].astype(str).to_numpy() if "status" in edges.columns else np.full(len(edges), "kept")
@@ -59,6 +60,8 @@ def plans_from_tables(nodes: pd.DataFrame, edges: pd.DataFrame, pruning: str = "
     by_scene = dict(tuple(edges.groupby(scene_col, sort=False)))
     out = []
     for scene_id, g in nodes.groupby(scene_col, sort=False):
+        if limit is not None and len(out) >= limit:
+            break
         objs = g[g["kind"].astype(str) == "object"]
         e = by_scene.get(scene_id, edges.iloc[:0])
         src_room = str(g["source_room_id"].iloc[0]) if "source_room_id" in g.columns else str(scene_id)

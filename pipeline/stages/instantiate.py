@@ -127,7 +127,7 @@ def select_plans(config: dict, variant: dict, ctx: Context, nodes: Path, edges: 
         held = [("room_id", "in", ctx.heldout_ids)]
         node_df = tables.read(nodes, "final_nodes", filters=flt + held).to_pandas()
         edge_df = tables.read(edges, "final_edges", filters=flt + held).to_pandas()
-    return plans_from_tables(node_df, edge_df, variant["pruning"], config["seed"])[:count]
+    return plans_from_tables(node_df, edge_df, variant["pruning"], config["seed"], limit=count)
 
 
 def scene_count(ic: dict, variant: dict) -> int:
