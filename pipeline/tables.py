@@ -205,7 +205,8 @@ SCHEMAS["generated_objects"] = pa.schema([*SCHEMAS["objects"], _f("scene_id", _S
 SCHEMAS["scenes"] = pa.schema([
     _f("scene_id", _STR, nullable=False), _f("room_type", _CAT), _f("variant", _CAT, doc="instantiate.variants key"),
     _f("source_room_id", _STR, doc="the room whose architecture (and, for held-out graphs, graph) the scene uses"),
-    _f("status", _CAT, doc="placed | failed"), _f("reason", _STR, doc="why the search failed"),
+    _f("status", _CAT, doc="placed | partial (objects dropped: instantiate.on_exhausted) | failed"),
+    _f("reason", _STR, doc="why the search failed, or which objects a partial scene dropped"),
     _f("seconds", _F64, "s"), _f("planned_objects", _I32), _f("placed_objects", _I32),
     _f("insertions", _I32, doc="accepted placements, those undone by backtracking included"),
     _f("rejections", _I32, doc="candidates that failed a check"), _f("backtracks", _I32),

@@ -9,7 +9,9 @@ import pytest
 import trimesh
 
 from conftest import Room, default_config
+from pipeline.geometry.boxes import footprint_corners
 from pipeline.geometry.frames import Frame, equivalent_frames, side_in, to_local, to_world
+from pipeline.geometry.polygon import outside_area
 from pipeline.geometry.raycast import intersector_class
 from pipeline.placement import export, order, scene_metrics
 from pipeline.placement.checks import Checker
@@ -125,6 +127,25 @@ def test_an_unsatisfiable_graph_ends_with_a_failure_record_not_a_hang():
     assert set(out.failures) == {"outside"}
 
 
+@pytest.mark.parametrize("mode", ["fail", "drop"])
+def test_an_object_with_no_place_fails_the_scene_or_is_dropped_with_what_it_supports(mode):
+    """The bed cannot fit the 1.4 m room; the lamp stands on it; the nightstand fits. PlanIT's search fails the
+    scene; ``on_exhausted: drop`` leaves out the bed and its lamp, places the nightstand and says so."""
+    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"], NARROW, max_backtracks=6,
+                                              on_exhausted=mode)
+    plan = ScenePlan("s3", "r0", "bedroom", ["b", "n", "l"], ["bed", "nightstand", "table_lamp"],
+                     ["left-right", "left-right", "radial"], [1, 1, 2], [None, None, "b"], ["none"] * 3,
+                     [PlanEdge("wall_0", "b", "spatial", "front", "adjacent"),
+                      PlanEdge("wall_0", "n", "spatial", "front", "adjacent"), PlanEdge("b", "l", "support", None, None)])
+    out = instantiate(plan, room, walls, [0, 1, 2], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
+    if mode == "fail":
+        assert out.status == "failed" and "no place for b (bed)" in out.reason and out.room.object_ids == []
+    else:
+        assert out.status == "partial" and out.dropped == ["b", "l"] and out.room.object_ids == ["n"]
+        assert out.reason == "dropped 2 of 3 objects once the backtrack budget was spent: b, l"
+        assert outside_area(np.array(NARROW, float), footprint_corners(*out.room.boxes[0, [0, 1, 3, 4, 6]]), 0.0)[0] < 1e-4
+
+
 def test_the_time_budget_ends_a_scene_with_its_reason():
     room, walls, catalog, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, time_budget=0.3)
     out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
@@ -139,9 +160,6 @@ def test_an_l_shaped_room_keeps_furniture_inside_its_outline():
                                         PlanEdge(walls.ids[3], "d", "spatial", "front", "adjacent")])
     out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 3)
     assert out.ok, out.reason
-    from pipeline.geometry.boxes import footprint_corners
-    from pipeline.geometry.polygon import outside_area
-
     corners = footprint_corners(*out.room.boxes[:, [0, 1, 3, 4, 6]].T)
     assert (outside_area(np.array(outline, float), corners, ic["checks"]["outside"]) <= 1e-4).all()
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
@@ -246,7 +264,6 @@ def test_real_3d_front_rooms_are_placed_again_from_their_own_graphs(tmp_path):
 
 def test_a_floor_object_may_not_stand_in_a_doors_clearance_zone():
     """The zone lies inside the room whichever way the door segment runs, also on an L-shaped room's inner wall."""
-    from pipeline.geometry.boxes import footprint_corners
     from pipeline.placement.checks import blocks_door
 
     l_room = [(0, 0), (4, 0), (4, 2), (2, 2), (2, 4), (0, 4)]

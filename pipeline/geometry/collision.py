@@ -3,7 +3,8 @@
 Boxes overstate overlap wherever a shape is not a box (an L-shaped sofa's box swallows its coffee table, a table's
 box holds the chair tucked under it). Where both objects have a mesh, the depth is measured on the meshes: the
 overlap of their boxes is sampled on a grid, each point is tested inside or outside each mesh by ray parity (three
-skewed directions, majority vote, so a mesh with small holes still reads right), and the depth is the thickness of
+skewed directions, majority vote, so a mesh with small holes still reads right; one mesh per ray scene, so rays
+step through that mesh's faces alone, and the second mesh only at the points inside the first), and the depth is the thickness of
 the region inside both: twice its largest inscribed radius (a Euclidean distance transform). For a slab of overlap,
 or a box corner pushed into a box, that is the smallest push that clears it; a corner turned 45 deg reads 0.83 of its
 depth (the wedge's inscribed diameter). Accurate to one grid pitch.

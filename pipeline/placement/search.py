@@ -6,7 +6,8 @@ slides flush against the anchors it must be adjacent to, then must pass :func:`~
 After its sample budget, the search backtracks to the nearest earlier object that caused one of its failures (or
 the one before it) and that object is placed afresh elsewhere. The relation tolerance stays 0 for the first
 quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``. A scene fails, with its reason,
-when the backtrack or time budget runs out.
+when the backtrack or time budget runs out; with ``on_exhausted: drop``, an object that finds no place once the
+backtrack budget is spent is left out instead (with the objects it supports) and the search goes on.
 """
 from __future__ import annotations
 
@@ -63,6 +64,11 @@ class Outcome:
     rejections: int = 0
     backtracks: int = 0
     failures: dict = field(default_factory=dict)  # reason kind -> count
+    dropped: list = field(default_factory=list)  # plan ids left out (on_exhausted: drop), in the order dropped
+
+    @property
+    def status(self) -> str:
+        return "failed" if not self.ok else "partial" if self.dropped else "placed"
 
 
 class Grid:
@@ -175,6 +181,7 @@ class Search:
         self.unit = {}
         self.backtracks = self.rejections = self.insertions = 0
         self.failures: dict[str, int] = {}
+        self.dropped: list[str] = []
 
     def model_for(self, k: int):
         """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's."""
@@ -273,11 +280,19 @@ class Search:
             if time.perf_counter() > deadline:
                 return f"time budget ({self.cfg['time_budget']} s) spent at object {i + 1} of {len(self.order)}"
             k = self.order[i]
+            if self.plan.parent[k] in self.dropped:  # its support was left out: so is it
+                self.dropped.append(self.plan.ids[k])
+                i += 1
+                continue
             culprits = self.try_place(k)
             if culprits is None:
                 i += 1
                 continue
             if self.backtracks >= self.cfg["max_backtracks"]:
+                if self.cfg["on_exhausted"] == "drop":
+                    self.dropped.append(self.plan.ids[k])
+                    i += 1
+                    continue
                 return f"backtrack budget ({self.cfg['max_backtracks']}) spent: no place for {self.plan.ids[k]} ({self.plan.categories[k]})"
             self.backtracks += 1
             if i == 0:  # nothing to undo: the first object tries again afresh
@@ -302,5 +317,8 @@ def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int]
     start = time.perf_counter()
     s = Search(plan, room, walls, order, proposer, catalog, checker, cfg, np.random.default_rng(seed))
     reason = s.run(start + cfg["time_budget"])
-    return Outcome(not reason, s.room, reason, time.perf_counter() - start, s.insertions, s.rejections, s.backtracks,
-                   s.failures)
+    ok = not reason
+    if ok and s.dropped:
+        reason = f"dropped {len(s.dropped)} of {len(order)} objects once the backtrack budget was spent: {', '.join(s.dropped)}"
+    return Outcome(ok, s.room, reason, time.perf_counter() - start, s.insertions, s.rejections, s.backtracks,
+                   s.failures, s.dropped)

@@ -35,6 +35,7 @@ class RoomSet:
     parents: list[list]
     scenes: pd.DataFrame | None = None  # scene_id, consistency, violation (placed scenes)
     attempted: int = 0
+    partial: int = 0  # scored scenes that dropped objects (instantiate.on_exhausted: drop)
 
 
 def room_set(name: str, rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.DataFrame,
@@ -46,14 +47,15 @@ def room_set(name: str, rooms: pd.DataFrame, architecture: pd.DataFrame, objects
 
 
 def load_generated(name: str, folder: Path) -> RoomSet:
-    """A variant's placed scenes (failed ones are counted, not scored)."""
+    """A variant's placed scenes, partial ones included (failed ones are counted, not scored)."""
     read = lambda t, schema: tables.read(folder / f"{t}.parquet", schema).to_pandas()
     scenes = read("scenes", "scenes")
-    placed = set(scenes.loc[scenes["status"].astype(str) == "placed", "scene_id"])
+    placed = set(scenes.loc[scenes["status"].astype(str).isin(["placed", "partial"]), "scene_id"])
     rooms = read("rooms", "rooms")
     out = room_set(name, rooms[rooms["room_id"].isin(placed)], read("architecture", "architecture"),
                    read("objects", "generated_objects"), scenes[scenes["scene_id"].isin(placed)])
     out.attempted = len(scenes)
+    out.partial = int((scenes["status"].astype(str) == "partial").sum())
     return out
 
 
@@ -130,7 +132,7 @@ def set_summary(rows: pd.DataFrame, rs: RoomSet, real: RoomSet, eps: float) -> d
     objects = max(int(rows["objects"].sum()), 1)
     mean = lambda col: None if rows[col].isna().all() else round(float(rows[col].mean()), 5)
     return {
-        "scenes": len(rows), "attempted": rs.attempted,
+        "scenes": len(rows), "attempted": rs.attempted, "partial": rs.partial,
         "category_kl": round(distributions.category_kl(_categories(real), _categories(rs), eps), 6),
         "count_distance": round(distributions.count_distance([len(r.object_ids) for r in real.rooms],
                                                              [len(r.object_ids) for r in rs.rooms]), 5),

@@ -95,7 +95,7 @@ def scene_rows(plan: ScenePlan, ctx: Context, outcome, walls, variant_name: str)
     metrics = scene_metrics.consistency(plan, room, walls.ids, ctx.checker)
     parents = dict(zip(plan.ids, plan.parent))
     record = {"scene_id": plan.scene_id, "room_type": ctx.room_type, "variant": variant_name, "source_room_id": plan.room_id,
-              "status": "placed" if outcome.ok else "failed", "reason": outcome.reason, "seconds": outcome.seconds,
+              "status": outcome.status, "reason": outcome.reason, "seconds": outcome.seconds,
               "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids), "insertions": outcome.insertions,
               "rejections": outcome.rejections, "backtracks": outcome.backtracks, "failures": json.dumps(outcome.failures),
               **metrics, "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
@@ -167,8 +167,8 @@ def write_outputs(config: dict, ctx: Context, plans: list[ScenePlan], proposer, 
         seed = zlib.crc32(f"{config['seed']}/{variant_name}/{plan.scene_id}".encode())
         outcome, walls = place_scene(plan, ctx, proposer, config["instantiate"], variant, seed, keep)
         record, r, a, o = scene_rows(plan, ctx, outcome, walls, variant_name)
-        if not outcome.ok:
-            log.warning("scene %s failed: %s", plan.scene_id, outcome.reason)
+        if outcome.status != "placed":
+            log.warning("scene %s %s: %s", plan.scene_id, outcome.status, outcome.reason)
         write_scene_files(out_folder / "scenes", plan, ctx, outcome, walls, record)
         records.append(record)
         room_rows += r
@@ -191,11 +191,12 @@ def write_outputs(config: dict, ctx: Context, plans: list[ScenePlan], proposer, 
 
 
 def summarise(scenes: pd.DataFrame) -> dict:
-    """Table 3's figures over a variant's scenes."""
-    placed = scenes["status"] == "placed"
+    """Table 3's figures over a variant's scenes (violation and consistency over the placed and partial ones)."""
     if scenes.empty:
-        return {"scenes": 0, "placed": 0, "failed": 0}
-    return {"scenes": int(len(scenes)), "placed": int(placed.sum()), "failed": int((~placed).sum()),
+        return {"scenes": 0, "placed": 0, "partial": 0, "failed": 0}
+    placed = scenes["status"].isin(["placed", "partial"])
+    return {"scenes": int(len(scenes)), "placed": int((scenes["status"] == "placed").sum()),
+            "partial": int((scenes["status"] == "partial").sum()), "failed": int((~placed).sum()),
             "rejections_per_scene": round(float(scenes["rejections"].mean()), 3),
             "backtracks_per_insertion": round(float(scenes["backtracks"].sum() / max(scenes["insertions"].sum(), 1)), 4),
             "violation": round(float(scenes.loc[placed, "violation"].mean()), 4) if placed.any() else None,
