@@ -40,6 +40,9 @@ class Catalog:
             self.by_cat.setdefault(cat, []).append(inst)
             self.sym.setdefault(cat, []).append(symmetry.get(model, "none"))
 
+    def has(self, category: str) -> bool:
+        return category in self.by_cat
+
     def pick(self, category: str, symmetry: str, rng: np.random.Generator) -> Instance:
         """A random instance of the category, of the node's symmetry where the category has one."""
         if category not in self.by_cat:

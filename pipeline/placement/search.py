@@ -6,8 +6,8 @@ slides flush against the anchors it must be adjacent to, then must pass :func:`~
 After its sample budget, the search backtracks to the nearest earlier object that caused one of its failures (or
 the one before it) and that object is placed afresh elsewhere. The relation tolerance stays 0 for the first
 quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``. A scene fails, with its reason,
-when the backtrack or time budget runs out; with ``on_exhausted: drop``, an object that finds no place once the
-backtrack budget is spent is left out instead (with the objects it supports) and the search goes on.
+when the backtrack or time budget runs out, or an object's category has no training instance; with
+``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search goes on.
 """
 from __future__ import annotations
 
@@ -280,10 +280,13 @@ class Search:
             if time.perf_counter() > deadline:
                 return f"time budget ({self.cfg['time_budget']} s) spent at object {i + 1} of {len(self.order)}"
             k = self.order[i]
-            if self.plan.parent[k] in self.dropped:  # its support was left out: so is it
-                self.dropped.append(self.plan.ids[k])
+            missing = not self.catalog.has(self.plan.categories[k])  # a held-out room's category no training room has
+            if self.plan.parent[k] in self.dropped or (missing and self.cfg["on_exhausted"] == "drop"):
+                self.dropped.append(self.plan.ids[k])  # its support was left out, or it has no model: so is it
                 i += 1
                 continue
+            if missing:
+                return f"no training instance of category '{self.plan.categories[k]}' for {self.plan.ids[k]}"
             culprits = self.try_place(k)
             if culprits is None:
                 i += 1
@@ -319,6 +322,7 @@ def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int]
     reason = s.run(start + cfg["time_budget"])
     ok = not reason
     if ok and s.dropped:
-        reason = f"dropped {len(s.dropped)} of {len(order)} objects once the backtrack budget was spent: {', '.join(s.dropped)}"
+        reason = f"dropped {len(s.dropped)} of {len(order)} objects (no place once the backtrack budget was spent, no " \
+                 f"training model, or their support dropped): {', '.join(s.dropped)}"
     return Outcome(ok, s.room, reason, time.perf_counter() - start, s.insertions, s.rejections, s.backtracks,
                    s.failures, s.dropped)
