@@ -10,12 +10,14 @@ from .checks import Checker, collision, edge_cost, found_edges
 from .plan import ScenePlan
 
 
-def consistency(plan: ScenePlan, room: RoomInput, walls_ids: list[str], checker: Checker) -> dict:
-    """Counts over the planned edges whose two ends are in the room."""
+def consistency(plan: ScenePlan, room: RoomInput, walls_ids: list[str], checker: Checker, dropped=()) -> dict:
+    """Counts over the planned edges whose two ends are in the room or among the ``dropped`` plan ids (a partial
+    scene's edges to what it left out are edges not found)."""
     present = set(room.object_ids) | set(walls_ids)
+    counted = present | set(dropped)
     edges = checker.extract(room).edges
     found = found_edges(edges)
-    planned = [e for e in plan.edges if e.source in present and e.target in present]
+    planned = [e for e in plan.edges if e.source in counted and e.target in counted]
     costs = np.array([edge_cost(e, found) for e in planned])
     pairs = {(e.source, e.target) for e in planned}
     objects = set(room.object_ids)

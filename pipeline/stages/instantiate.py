@@ -92,7 +92,7 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
 def scene_rows(plan: ScenePlan, ctx: Context, outcome, walls, variant_name: str) -> tuple[dict, list[dict], list[dict], dict]:
     """The scene's record and its rooms / architecture / objects rows (its room id is the scene id)."""
     room = outcome.room
-    metrics = scene_metrics.consistency(plan, room, walls.ids, ctx.checker)
+    metrics = scene_metrics.consistency(plan, room, walls.ids, ctx.checker, outcome.dropped)
     parents = dict(zip(plan.ids, plan.parent))
     record = {"scene_id": plan.scene_id, "room_type": ctx.room_type, "variant": variant_name, "source_room_id": plan.room_id,
               "status": outcome.status, "reason": outcome.reason, "seconds": outcome.seconds,
