@@ -158,6 +158,7 @@ def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_c
     out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
     if mode == "fail":
         assert out.status == "failed" and out.reason == "no training instance of category 'vacuum_cleaner' for v"
+        assert out.room.object_ids == []  # failed before placing the nightstand
     else:
         assert out.status == "partial" and out.dropped == ["v"] and out.room.object_ids == ["n"]
 

@@ -71,6 +71,9 @@ class Outcome:
         return "failed" if not self.ok else "partial" if self.dropped else "placed"
 
 
+SCORED = ("placed", "partial")  # the statuses of scenes that hold a room to score (a partial one lacks what it dropped)
+
+
 class Grid:
     """Candidate centres: cell centres over the room's bounding square at ``mpp``, and those on the floor."""
 
@@ -275,18 +278,19 @@ class Search:
         for u, unit in enumerate(chains(self.plan)):
             for k in unit:
                 self.unit[k] = u
+        missing = {k for k in self.order if not self.catalog.has(self.plan.categories[k])}  # held-out categories
+        if missing and self.cfg["on_exhausted"] == "fail":  # no model to place: fail before placing anything
+            k = next(k for k in self.order if k in missing)
+            return f"no training instance of category '{self.plan.categories[k]}' for {self.plan.ids[k]}"
         i = 0
         while i < len(self.order):
             if time.perf_counter() > deadline:
                 return f"time budget ({self.cfg['time_budget']} s) spent at object {i + 1} of {len(self.order)}"
             k = self.order[i]
-            missing = not self.catalog.has(self.plan.categories[k])  # a held-out room's category no training room has
-            if self.plan.parent[k] in self.dropped or (missing and self.cfg["on_exhausted"] == "drop"):
-                self.dropped.append(self.plan.ids[k])  # its support was left out, or it has no model: so is it
+            if k in missing or self.plan.parent[k] in self.dropped:  # no model, or its support was left out
+                self.dropped.append(self.plan.ids[k])
                 i += 1
                 continue
-            if missing:
-                return f"no training instance of category '{self.plan.categories[k]}' for {self.plan.ids[k]}"
             culprits = self.try_place(k)
             if culprits is None:
                 i += 1

@@ -21,6 +21,7 @@ from ..geometry.raycast import intersector_class
 from ..learn.graph_data import split_heldout
 from ..log import progress
 from ..placement.checks import Checker
+from ..placement.search import SCORED
 from ..roomdata import room_inputs
 
 log = logging.getLogger("planit.evaluate")
@@ -35,7 +36,6 @@ class RoomSet:
     parents: list[list]
     scenes: pd.DataFrame | None = None  # scene_id, consistency, violation (placed scenes)
     attempted: int = 0
-    partial: int = 0  # scored scenes that dropped objects (instantiate.on_exhausted: drop)
 
 
 def room_set(name: str, rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.DataFrame,
@@ -50,12 +50,11 @@ def load_generated(name: str, folder: Path) -> RoomSet:
     """A variant's placed scenes, partial ones included (failed ones are counted, not scored)."""
     read = lambda t, schema: tables.read(folder / f"{t}.parquet", schema).to_pandas()
     scenes = read("scenes", "scenes")
-    placed = set(scenes.loc[scenes["status"].astype(str).isin(["placed", "partial"]), "scene_id"])
+    placed = set(scenes.loc[scenes["status"].astype(str).isin(SCORED), "scene_id"])
     rooms = read("rooms", "rooms")
     out = room_set(name, rooms[rooms["room_id"].isin(placed)], read("architecture", "architecture"),
                    read("objects", "generated_objects"), scenes[scenes["scene_id"].isin(placed)])
     out.attempted = len(scenes)
-    out.partial = int((scenes["status"].astype(str) == "partial").sum())
     return out
 
 
@@ -132,7 +131,8 @@ def set_summary(rows: pd.DataFrame, rs: RoomSet, real: RoomSet, eps: float) -> d
     objects = max(int(rows["objects"].sum()), 1)
     mean = lambda col: None if rows[col].isna().all() else round(float(rows[col].mean()), 5)
     return {
-        "scenes": len(rows), "attempted": rs.attempted, "partial": rs.partial,
+        "scenes": len(rows), "attempted": rs.attempted,
+        "partial": 0 if rs.scenes is None else int((rs.scenes["status"].astype(str) == "partial").sum()),
         "category_kl": round(distributions.category_kl(_categories(real), _categories(rs), eps), 6),
         "count_distance": round(distributions.count_distance([len(r.object_ids) for r in real.rooms],
                                                              [len(r.object_ids) for r in rs.rooms]), 5),

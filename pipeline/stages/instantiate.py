@@ -22,7 +22,7 @@ from ..placement.checks import Checker
 from ..placement.layout import walls_of, with_objects
 from ..placement.plan import ScenePlan, plans_from_tables
 from ..placement.retrieval import Catalog
-from ..placement.search import instantiate
+from ..placement.search import SCORED, instantiate
 from .train_placement import load_rooms
 
 log = logging.getLogger("planit.instantiate")
@@ -194,13 +194,13 @@ def summarise(scenes: pd.DataFrame) -> dict:
     """Table 3's figures over a variant's scenes (violation and consistency over the placed and partial ones)."""
     if scenes.empty:
         return {"scenes": 0, "placed": 0, "partial": 0, "failed": 0}
-    placed = scenes["status"].isin(["placed", "partial"])
+    scored = scenes["status"].isin(SCORED)
     return {"scenes": int(len(scenes)), "placed": int((scenes["status"] == "placed").sum()),
-            "partial": int((scenes["status"] == "partial").sum()), "failed": int((~placed).sum()),
+            "partial": int((scenes["status"] == "partial").sum()), "failed": int((~scored).sum()),
             "rejections_per_scene": round(float(scenes["rejections"].mean()), 3),
             "backtracks_per_insertion": round(float(scenes["backtracks"].sum() / max(scenes["insertions"].sum(), 1)), 4),
-            "violation": round(float(scenes.loc[placed, "violation"].mean()), 4) if placed.any() else None,
-            "consistency": round(float(scenes.loc[placed, "consistency"].mean()), 4) if placed.any() else None,
+            "violation": round(float(scenes.loc[scored, "violation"].mean()), 4) if scored.any() else None,
+            "consistency": round(float(scenes.loc[scored, "consistency"].mean()), 4) if scored.any() else None,
             "collision_rate": round(float(scenes["colliding_objects"].sum() / max(scenes["placed_objects"].sum(), 1)), 4),
             "median_seconds": round(float(scenes["seconds"].median()), 3),
             "unplanned_adjacent_per_scene": round(float(scenes["unplanned_adjacent"].mean()), 3)}
