@@ -269,13 +269,13 @@ def sample_graphs(config: Optional[Path] = ConfigOpt, config_json: Optional[str]
 @app.command("graph-model-metrics")
 def graph_model_metrics(config: Optional[Path] = ConfigOpt, config_json: Optional[str] = JsonOpt,
                         room_type: str = typer.Option(..., "--room-type"), model: Path = _file("--model"),
-                        history: Path = _file("--history"), nodes: Path = _file("--nodes"), edges: Path = _file("--edges"),
+                        nodes: Path = _file("--nodes"), edges: Path = _file("--edges"),
                         gen_nodes: Path = _file("--gen-nodes"), gen_edges: Path = _file("--gen-edges"),
                         sample_summary: Path = _file("--sample-summary"), out: Path = _file("--out")) -> None:
     """Evaluate a room type's graph model (held-out NLL; generated vs held-out graphs beside the sampling floor)."""
     from .stages import graph_model_metrics as stage
 
-    result = _stage(stage.run, config, config_json, room_type, model, history, nodes, edges, gen_nodes, gen_edges,
+    result = _stage(stage.run, config, config_json, room_type, model, nodes, edges, gen_nodes, gen_edges,
                     sample_summary, out)
     typer.echo(json.dumps(result["goals"]))
 

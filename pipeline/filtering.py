@@ -85,7 +85,11 @@ def _placement_reasons(room, objs: dict, cfg: dict) -> list[tuple[str, str]]:
 
 def penetrating_pairs(box_depth: np.ndarray, objs: dict, cfg: dict) -> Iterator[tuple[int, int, float, str]]:
     """Pairs ``(i, j, depth, measure)``, deepest box overlap first, that penetrate deeper than ``max_penetration``:
-    measured on the meshes where both objects have one (``penetration.measure: mesh``), else on the boxes."""
+    measured on the meshes where both objects have one (``penetration.measure: mesh``), else on the boxes.
+
+    ``cfg['confirm']`` (optional, a finer ``penetration``): a mesh pair the first grid clears is measured again on
+    this one, so a coarse grid may screen but never clear a pair that the finer measure finds penetrating (the
+    depth is accurate to one pitch only)."""
     pen, limit = cfg["penetration"], cfg["max_penetration"]
     i, j = np.nonzero(np.triu(box_depth > limit, 1))
     for k in np.argsort(-box_depth[i, j], kind="stable"):
@@ -94,9 +98,19 @@ def penetrating_pairs(box_depth: np.ndarray, objs: dict, cfg: dict) -> Iterator[
         if pen["measure"] == "box" or ma is None or mb is None:
             yield a, b, float(box_depth[a, b]), "boxes"
             continue
-        d = mesh_penetration(_world(ma, objs["poses"][a]), _world(mb, objs["poses"][b]), cfg["intersector"], pen)
+        d = _mesh_depth(_world(ma, objs["poses"][a]), _world(mb, objs["poses"][b]), float(box_depth[a, b]), cfg)
         if d > limit:
             yield a, b, d, "meshes"
+
+
+def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], box_depth: float, cfg: dict) -> float:
+    """Two world meshes' penetration on ``cfg['penetration']``'s grid, measured again on ``cfg['confirm']``'s where
+    the first finds at most ``max_penetration`` (``confirm.measure: box`` takes the boxes' depth instead)."""
+    d = mesh_penetration(a, b, cfg["intersector"], cfg["penetration"])
+    confirm = cfg.get("confirm")
+    if confirm is None or d > cfg["max_penetration"]:
+        return d
+    return box_depth if confirm["measure"] == "box" else mesh_penetration(a, b, cfg["intersector"], confirm)
 
 
 def deepest_penetration(box_depth: np.ndarray, objs: dict, cfg: dict) -> tuple[int, int, float, str] | None:

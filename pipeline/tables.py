@@ -483,6 +483,8 @@ def records_by_room(path: str | Path, name: str) -> dict[str, list[dict]]:
 def read_meshes(path: str | Path, model_ids) -> tuple[dict, set]:
     """The meshes of the models ``model_ids`` from a ``models`` table (the filter is pushed into the read): model id
     -> ``(vertices, faces)``, and the ids whose mesh is only their box (``mesh_kind`` box_fallback)."""
+    if not len(model_ids):  # pyarrow cannot type an empty "in" filter
+        return {}, set()
     rows = read(path, "models", filters=[("model_id", "in", sorted(set(model_ids)))],
                 columns=["model_id", "vertices", "faces", "mesh_kind"]).to_pylist()
     return {m["model_id"]: model_mesh(m) for m in rows}, {m["model_id"] for m in rows if m["mesh_kind"] == "box_fallback"}

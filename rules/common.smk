@@ -68,7 +68,8 @@ TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldo
 # what placement training reads
 PLACEMENT_TRAIN_KEYS = ["preset", f"presets.{config['placement']['preset']}", "device"]
 # what training reads (sampling settings are not among them: changing them resamples without retraining)
-GRAPH_TRAIN_KEYS = ["preset", f"presets.{config['graph_model']['preset']}", "max_edges", "heldout_fraction", "device"]
+GRAPH_TRAIN_KEYS = ["preset", f"presets.{config['graph_model']['preset']}", "max_edges", "heldout_fraction", "validation_fraction",
+                    "device"]
 
 
 def keys(*dotted):
@@ -79,9 +80,10 @@ def keys(*dotted):
 
 def instantiate_keys(wildcards):
     """Params function: the keys an instantiation job reads, its own variant's spec only (adding or changing another
-    variant reruns nothing here)."""
+    variant reruns nothing here), and the evaluation's penetration measure its collision check confirms with."""
     own = [f"instantiate.{k}" for k in config["instantiate"] if k not in ("variants", "table3_room_types")]
-    return keys("seed", "extract", "floor_contact", *own, f"instantiate.variants.{wildcards.variant}")
+    return keys("seed", "extract", "floor_contact", *own, f"instantiate.variants.{wildcards.variant}",
+                "evaluate.collision.penetration")
 
 
 def shards_of(template, **fixed):

@@ -57,7 +57,6 @@ rule sample_graphs:
 rule graph_model_metrics:
     input:
         model=GRAPH_MODEL.replace("{name}", "model.pt"),
-        history=GRAPH_MODEL.replace("{name}", "history.csv"),
         nodes=GATHERED.format(corpus="ingested", table="nodes"),
         edges=GATHERED.format(corpus="ingested", table="edges"),
         gen_nodes=GRAPH_MODEL.replace("{name}", "sampled/nodes.parquet"),
@@ -75,6 +74,6 @@ rule graph_model_metrics:
         ENV
     shell:
         "planit graph-model-metrics --config-json {params.config:q} --room-type {wildcards.room_type} "
-        "--model {input.model} --history {input.history} --nodes {input.nodes} --edges {input.edges} "
+        "--model {input.model} --nodes {input.nodes} --edges {input.edges} "
         "--gen-nodes {input.gen_nodes} --gen-edges {input.gen_edges} --sample-summary {input.sample_summary} "
         "--out {output.metrics} 2> {log}"

@@ -121,3 +121,25 @@ def test_real_furniture_meshes_overlap_far_less_than_their_boxes(tmp_path):
     edges = pd.read_parquet(tmp_path / "e.parquet")
     assert len(nodes[nodes.kind == "object"]) >= 100
     assert (nodes[nodes.kind == "object"].tier == 1).all() and not (edges.edge_type == "support").any()
+
+
+def test_a_pair_the_coarse_per_attempt_grid_clears_is_measured_again_the_evaluations_way():
+    """Two box meshes 1.5 cm into each other: a 4 cm screening grid has no point inside both and clears them; the
+    instantiation's check then measures again on the evaluation's grid, so it and the evaluation both call it a
+    collision (the bathroom toilet and vanity the coarse grid once passed at 0.98 cm: 1.75 cm by the evaluation)."""
+    from pipeline.evaluation import physical
+    from pipeline.placement.checks import Checker, checks_config, collision as check_collision
+
+    cfg = config.validate({})
+    r = Room([[0, 0], [4, 0], [4, 4], [0, 4]], room_type="bathroom")
+    r.add("a", "cabinet", (1.0, 1.0, 1.0), (1.5, 2.0))
+    r.add("b", "cabinet", (1.0, 1.0, 1.0), (2.485, 2.3))
+    room, ext = r.room_input(), {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
+    screen = {"measure": "mesh", "resolution": 4, "min_pitch": 0.04, "max_cells": 1000}
+    checks = {**checks_config(cfg), "penetration": screen}
+    assert checks_config(cfg)["confirm"] == cfg["evaluate"]["collision"]["penetration"]
+    assert check_collision(room, 1, set(), Checker(r.models, set(), {}, ext, EMBREE, {**checks, "confirm": None})) is None
+    hit = check_collision(room, 1, set(), Checker(r.models, set(), {}, ext, EMBREE, checks))
+    assert hit is not None and hit[0] == 0 and hit[1] == pytest.approx(0.015, abs=0.0065)  # one pitch: 6 mm here
+    ev = {**cfg["evaluate"]["collision"], "intersector": EMBREE}
+    assert physical.colliding(room, [None, None], [r.models[m] for m in room.model_ids], ev).all()

@@ -58,6 +58,7 @@ def test_invalid_graphs_are_named():
     seen = {(cls[s], cls[t], c) for s, t, c in ok}
     assert graph_checks.problems(cls, role, ok, 1, seen) == []
     assert graph_checks.problems(cls, role, ok[:2], 1, seen) == ["disconnected"]
+    assert graph_checks.problems(cls[:1], role[:1], [], 1, seen) == ["empty"]  # walls alone: no room to furnish
     assert "cyclic" in graph_checks.problems(cls, role, ok + [(3, 1, left)], 1, seen | {(5, 3, left)})
     assert graph_checks.problems(cls, role, ok + [(3, 2, left)], 1, seen) == ["cyclic", "unseen_edge"]
     chain = graph_checks.ROLES.index("chain")
@@ -80,7 +81,7 @@ def test_tiny_model_overfits_a_graph_and_greedy_sampling_reproduces_it(bedrooms,
     vocab, graphs = bedrooms
     g = bed_lamp_graph(graphs[0], vocab)
     run = train.train([g], [g], vocab, {**TINY, "max_epochs": 120, "patience": 120}, 10, 0, tmp_path / "ck.pt", "h")
-    assert run.history[-1]["heldout_nll"] < 0.05 * run.history[0]["heldout_nll"]
+    assert run.history[-1]["validation_nll"] < 0.05 * run.history[0]["validation_nll"]
     out = sampler.sample(run.model, vocab, [g], seed=0, temperature=0.0, max_objects=25, max_edges=10)[0]
     assert same_graph(out.node_class, out.edges, g)
 
@@ -234,3 +235,17 @@ def test_batched_training_matches_one_graph_at_a_time(bedrooms):
         together = nll(m, make_batch(seqs, vocab))
         alone = torch.cat([nll(m, make_batch([s], vocab)) for s in seqs])
     assert torch.allclose(together, alone, atol=1e-4)
+
+
+def test_early_stopping_sees_validation_rooms_never_the_held_out_test_rooms():
+    """The graph model picks its epoch on training rooms held back from fitting; the held-out rooms it is evaluated
+    on (the same split the placement training and the evaluation use) take no part."""
+    from pipeline.stages.train_graph_model import splits
+
+    ids = [f"room_{k:03d}" for k in range(200)]
+    gm = config.validate({})["graph_model"]
+    fit, val, held = splits(ids, gm, seed=0)
+    assert sorted(fit + val + held) == ids and not (set(fit) & set(val)) and not (set(fit + val) & set(held))
+    assert (len(held), len(val)) == (30, 17)  # 0.15 of 200, then 0.1 of the 170 left
+    assert held == graph_data.split_heldout(ids, gm["heldout_fraction"], 0)[1]
+    assert splits(ids, gm, seed=0) == (fit, val, held) and splits(ids, gm, seed=1)[1] != val

@@ -59,6 +59,16 @@ class Browser:
         self.do("POST", f"/element/{element}/click", {})
         time.sleep(0.3)  # the report's React app re-renders
 
+    @staticmethod
+    def wait_for(probe, timeout: float = 10.0, step: float = 0.2):
+        """``probe()``'s first truthy value, polled every ``step`` s, or its last value after ``timeout`` s."""
+        end = time.monotonic() + timeout
+        while True:
+            value = probe()
+            if value or time.monotonic() > end:
+                return value
+            time.sleep(step)
+
     def run(self, script: str):
         return self.do("POST", "/execute/sync", {"script": script, "args": []})
 

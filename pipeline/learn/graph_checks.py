@@ -13,7 +13,7 @@ from .graph_data import N_OBJECT_EDGES, OBJECT_EDGES, ROLES
 
 CHAIN_ROLES = {ROLES.index("chain"), ROLES.index("hub+chain")}
 NEAR = {k for k, name in enumerate(OBJECT_EDGES) if name.endswith(("adjacent", "proximal"))}
-REASONS = ("disconnected", "cyclic", "unseen_edge", "inconsistent_chain")
+REASONS = ("empty", "disconnected", "cyclic", "unseen_edge", "inconsistent_chain")
 
 
 def seen_triples(graphs) -> set[tuple[int, int, int]]:
@@ -29,7 +29,7 @@ def seen_triples(graphs) -> set[tuple[int, int, int]]:
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
              seen: set[tuple[int, int, int]]) -> list[str]:
     """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class)."""
-    out = []
+    out = [] if len(node_class) > n_arch else ["empty"]  # every real room holds an object
     n = len(node_class)
     undirected = nx.Graph()
     undirected.add_nodes_from(range(n))

@@ -194,10 +194,11 @@ def sequence(graph: Graph, rng: np.random.Generator, max_edges: int) -> Sequence
     return Sequence(graph, order, links, dropped)
 
 
-def split_heldout(room_ids: list[str], fraction: float, seed: int) -> tuple[list[str], list[str]]:
-    """A seeded split of room ids into (train, held-out); at least one room in each when there are two or more."""
+def split_heldout(room_ids: list[str], fraction: float, seed: int, stream: int = 4242) -> tuple[list[str], list[str]]:
+    """A seeded split of room ids into (train, held-out); at least one room in each when there are two or more.
+    ``stream`` tells independent splits of one seed apart (the validation split of the training ids uses another)."""
     ids = sorted(room_ids)
-    rng = np.random.default_rng([seed, 4242])
+    rng = np.random.default_rng([seed, stream])
     perm = rng.permutation(len(ids))
     k = int(round(fraction * len(ids)))
     k = min(max(k, 1 if len(ids) > 1 else 0), max(len(ids) - 1, 0))

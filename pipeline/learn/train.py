@@ -1,8 +1,10 @@
-"""Training the graph model: batched teacher forcing, Adam, early stopping on held-out NLL, checkpoints that resume.
+"""Training the graph model: batched teacher forcing, Adam, early stopping on the validation NLL, checkpoints that
+resume.
 
 Every epoch draws new random node and edge orders from ``(seed, epoch)`` alone, so a run resumed from its
 checkpoint continues exactly as an uninterrupted one would (same orders, same optimizer state, same weights).
-The held-out NLL uses one fixed order per graph. The checkpoint (written atomically after every epoch) carries the
+The validation graphs are training rooms held back from fitting; the test rooms (the held-out split every
+evaluation compares with) play no part. Scoring a set (:func:`heldout_nll`) uses one fixed order per graph. The checkpoint (written atomically after every epoch) carries the
 config hash: a checkpoint of other settings is never resumed.
 """
 from __future__ import annotations
@@ -47,7 +49,7 @@ class Run:
 
 def heldout_nll(model: GraphModel, graphs: list[Graph], vocab: Vocab, seed: int, max_edges: int, batch_size: int,
                 device: str) -> np.ndarray:
-    """``(len(graphs), 3)`` NLL per held-out graph and decision kind, one fixed order per graph."""
+    """``(len(graphs), 3)`` NLL per graph (validation or test) and decision kind, one fixed order per graph."""
     rng = np.random.default_rng([seed, 77])
     seqs = [sequence(g, rng, max_edges) for g in graphs]
     out = []
@@ -74,10 +76,11 @@ def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) ->
     return total / max(len(seqs), 1), dropped
 
 
-def train(train_graphs: list[Graph], held: list[Graph], vocab: Vocab, preset: dict, max_edges: int, seed: int,
+def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, preset: dict, max_edges: int, seed: int,
           checkpoint: Path, config_hash: str, device: str = "cpu", progress=None) -> Run:
-    """Train until the held-out NLL has not improved by ``preset['min_improvement']`` (relative) for
-    ``preset['patience']`` epochs, or ``preset['max_epochs']``. ``progress(epoch, row)`` is called per epoch."""
+    """Fit ``train_graphs`` until the ``validation`` NLL has not improved by ``preset['min_improvement']``
+    (relative) for ``preset['patience']`` epochs, or ``preset['max_epochs']``; keep the epoch of the lowest
+    validation NLL. ``progress(epoch, row)`` is called per epoch."""
     torch.manual_seed(seed)
     model = build_model(vocab, preset).to(device)
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
@@ -100,17 +103,17 @@ def train(train_graphs: list[Graph], held: list[Graph], vocab: Vocab, preset: di
         train_nll, dropped = _epoch(model, opt, train_graphs, vocab, seed, epoch, preset, max_edges, device)
         seconds = time.perf_counter() - start
         model.eval()
-        held_nll = heldout_nll(model, held, vocab, seed, max_edges, preset["batch_size"], device)
-        row = {"epoch": epoch, "train_nll": train_nll, "heldout_nll": float(held_nll.sum(1).mean()),
-               **{f"heldout_{k}": float(held_nll[:, i].mean()) for i, k in enumerate(KINDS)},
+        val_nll = heldout_nll(model, validation, vocab, seed, max_edges, preset["batch_size"], device)
+        row = {"epoch": epoch, "train_nll": train_nll, "validation_nll": float(val_nll.sum(1).mean()),
+               **{f"validation_{k}": float(val_nll[:, i].mean()) for i, k in enumerate(KINDS)},
                "seconds": seconds, "graphs_per_s": len(train_graphs) / max(seconds, 1e-9), "edges_dropped": dropped}
         state["history"].append(row)
-        if row["heldout_nll"] < state["best"] * (1 - preset["min_improvement"]):
+        if row["validation_nll"] < state["best"] * (1 - preset["min_improvement"]):
             state["stale"] = 0
         else:
             state["stale"] += 1
-        if row["heldout_nll"] < state["best"]:
-            state.update(best=row["heldout_nll"], best_epoch=epoch, best_state=copy.deepcopy(model.state_dict()))
+        if row["validation_nll"] < state["best"]:
+            state.update(best=row["validation_nll"], best_epoch=epoch, best_state=copy.deepcopy(model.state_dict()))
         state["epoch"] = epoch
         tables.write_atomic(checkpoint, lambda tmp: torch.save({"config_hash": config_hash, "model": model.state_dict(),
                                                                 "optimizer": opt.state_dict(), "state": state}, tmp))

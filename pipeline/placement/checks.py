@@ -26,11 +26,17 @@ class Verdict:
     culprits: set[str] = field(default_factory=set)  # placed objects that caused the failure
 
 
+def checks_config(config: dict) -> dict:
+    """The ``instantiate.checks`` thresholds with the evaluation's penetration measure as ``confirm``: a pair the
+    coarse per-attempt grid clears is measured again the way the evaluation measures it."""
+    return {**config["instantiate"]["checks"], "confirm": config["evaluate"]["collision"]["penetration"]}
+
+
 @dataclass
 class Checker:
     """What the checks need besides the room: meshes (model id -> (vertices, faces)), box-only models, the model ->
     symmetry table, the extraction config (the ``extract`` section plus ``floor_contact``), the ray backend class
-    and the ``instantiate.checks`` thresholds."""
+    and the ``instantiate.checks`` thresholds (:func:`checks_config`: with the evaluation's measure to confirm)."""
     meshes: dict
     box_models: set
     symmetry: dict
@@ -59,7 +65,7 @@ def collision(room: RoomInput, k: int, related: set[int], checker: Checker) -> t
     objs = {"meshes": [None if m in checker.box_models else checker.meshes.get(m) for m in room.model_ids],
             "poses": room.poses}
     cfg = {"penetration": checker.cfg["penetration"], "max_penetration": checker.cfg["collision"],
-           "intersector": checker.intersector}
+           "intersector": checker.intersector, "confirm": checker.cfg.get("confirm")}
     hit = deepest_penetration(depth, objs, cfg)
     return None if hit is None else (hit[1] if hit[0] == k else hit[0], hit[2])
 

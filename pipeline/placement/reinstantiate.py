@@ -9,7 +9,7 @@ import pandas as pd
 from ..geometry.raycast import intersector_class
 from ..roomdata import room_inputs
 from . import order, scene_metrics
-from .checks import Checker
+from .checks import Checker, checks_config
 from .layout import walls_of, with_objects
 from .plan import plans_from_tables
 from .proposers import Combined, FaceAway, RelationPrior
@@ -28,7 +28,7 @@ def reinstantiate(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.D
     """One row per room with at least ``min_objects`` planned objects: placed or not, why, consistency, collisions."""
     ext = {"floor_contact": config["floor_contact"], **config["extract"]}
     ic = config["instantiate"]
-    checker = Checker(meshes, box_models, symmetry, ext, intersector_class(ext["backend"]), ic["checks"])
+    checker = Checker(meshes, box_models, symmetry, ext, intersector_class(ext["backend"]), checks_config(config))
     inputs = {r.room_id: r for r in room_inputs(rooms, architecture, objects)}
     catalog = Catalog(objects, symmetry, config["floor_contact"])
     areas = objects.assign(a=4 * objects["hx"] * objects["hy"]).groupby("category")["a"].mean().to_dict()

@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..geometry.raycast import intersector_class
 from ..log import progress
 from ..placement import export, order, proposers, scene_metrics
-from ..placement.checks import Checker
+from ..placement.checks import Checker, checks_config
 from ..placement.layout import walls_of, with_objects
 from ..placement.plan import ScenePlan, plans_from_tables
 from ..placement.retrieval import Catalog
@@ -56,7 +56,7 @@ def load_context(config: dict, room_type: str, saved: dict, rooms: list[Path], a
     sizes = tables.read(category_sizes, "category_sizes").to_pandas()
     sizes = sizes[sizes["room_type"].astype(str) == room_type]
     ext = {**config["extract"], "floor_contact": config["floor_contact"]}
-    checker = Checker(meshes, box_models, sym, ext, intersector_class(ext["backend"]), config["instantiate"]["checks"])
+    checker = Checker(meshes, box_models, sym, ext, intersector_class(ext["backend"]), checks_config(config))
     return Context(room_type, room_df, arch[arch["room_id"].isin(set(room_df["room_id"]))], objs,
                    {k: v for k, v in inputs.items() if k in set(room_df["room_id"])},
                    Catalog(objs[~objs["room_id"].isin(held)], sym, config["floor_contact"]), checker,

@@ -13,7 +13,7 @@ log = logging.getLogger("planit.train_graph_model")
 
 
 def room_graphs(nodes: Path, edges: Path, room_type: str):
-    """The room type's final graphs, their vocabulary, and the seeded (train, held-out) split of room ids."""
+    """The room type's final graphs and their vocabulary."""
     from ..learn import graph_data
 
     flt = [("room_type", "=", room_type)]
@@ -25,56 +25,83 @@ def room_graphs(nodes: Path, edges: Path, room_type: str):
     return vocab, graph_data.graphs_from_tables(node_df, edge_df, vocab)
 
 
+def splits(room_ids: list[str], gm: dict, seed: int) -> tuple[list[str], list[str], list[str]]:
+    """Seeded (fit, validation, test) room ids: the test rooms are the held-out split every evaluation uses; the
+    validation rooms come out of the rest."""
+    from ..learn import graph_data
+
+    rest, test = graph_data.split_heldout(room_ids, gm["heldout_fraction"], seed)
+    fit, validation = graph_data.split_heldout(rest, gm["validation_fraction"], seed, stream=4343)
+    return fit, validation, test
+
+
 def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path, out_history: Path, out_curve: Path,
         out_summary: Path, threads: int = 1) -> dict:
-    """Train, write the best weights (with vocabulary, split and seen edge types), the loss curves and a summary.
-    The checkpoint beside ``out_model`` resumes an interrupted run with the same settings."""
+    """Train, write the best weights (with vocabulary, split, the test NLL and seen edge types), the loss curves and
+    a summary. The checkpoint beside ``out_model`` resumes an interrupted run with the same settings."""
     import torch
 
-    from ..learn import graph_checks, graph_data, train
+    from ..learn import graph_checks, train
 
     gm = config["graph_model"]
     preset = gm["presets"][gm["preset"]]
     torch.set_num_threads(threads)
     vocab, graphs = room_graphs(nodes, edges, room_type)
-    train_ids, held_ids = graph_data.split_heldout([g.room_id for g in graphs], gm["heldout_fraction"], config["seed"])
-    if not train_ids or not held_ids:
-        raise InputError(f"{nodes}: room type '{room_type}' has {len(graphs)} graph(s); training needs 2 or more")
+    fit_ids, val_ids, held_ids = splits([g.room_id for g in graphs], gm, config["seed"])
+    if not fit_ids or not val_ids or not held_ids:
+        raise InputError(f"{nodes}: room type '{room_type}' has {len(graphs)} graph(s); training needs 3 or more "
+                         "(fitted, validation and held-out)")
     by_id = {g.room_id: g for g in graphs}
-    train_g, held_g = [by_id[i] for i in train_ids], [by_id[i] for i in held_ids]
+    train_g, val_g, held_g = ([by_id[i] for i in ids] for ids in (fit_ids, val_ids, held_ids))
     device = train.pick_device(gm["device"])
     chash = config_hash({"preset": preset, "max_edges": gm["max_edges"], "heldout_fraction": gm["heldout_fraction"],
-                         "seed": config["seed"], "room_type": room_type, "graphs": sorted(by_id)})
+                         "validation_fraction": gm["validation_fraction"], "seed": config["seed"],
+                         "room_type": room_type, "graphs": sorted(by_id)})
     bar = iter(progress(range(preset["max_epochs"]), desc=f"train {room_type} (max {preset['max_epochs']} epochs)"))
 
     def tick(epoch, row):
         next(bar, None)
-        log.info("epoch %d: train NLL %.2f, held-out NLL %.2f, %.1f graphs/s", epoch, row["train_nll"],
-                 row["heldout_nll"], row["graphs_per_s"])
+        log.info("epoch %d: train NLL %.2f, validation NLL %.2f, %.1f graphs/s", epoch, row["train_nll"],
+                 row["validation_nll"], row["graphs_per_s"])
 
-    run_ = train.train(train_g, held_g, vocab, preset, gm["max_edges"], config["seed"], out_model.with_name("checkpoint.pt"),
+    run_ = train.train(train_g, val_g, vocab, preset, gm["max_edges"], config["seed"], out_model.with_name("checkpoint.pt"),
                        chash, device, tick)
+    test = heldout_scores(run_.model, held_g, vocab, preset, gm["max_edges"], config["seed"], device)
+    log.info("held-out NLL of the chosen epoch (%d): %.2f per graph", run_.best_epoch, test["per_graph"])
     tables.write_atomic(out_model, lambda tmp: torch.save({
         "config_hash": chash, "room_type": room_type, "categories": list(vocab.categories), "preset": preset,
-        "max_edges": gm["max_edges"], "state_dict": run_.model.state_dict(), "train_ids": train_ids,
-        "heldout_ids": held_ids, "seen": sorted(graph_checks.seen_triples(train_g))}, tmp))
+        "max_edges": gm["max_edges"], "state_dict": run_.model.state_dict(), "train_ids": fit_ids,
+        "validation_ids": val_ids, "heldout_ids": held_ids, "heldout_nll": test,
+        "seen": sorted(graph_checks.seen_triples(train_g))}, tmp))
     import pandas as pd
 
     history = pd.DataFrame(run_.history)
     tables.write_csv(out_history, history)
     tables.write_figure(out_curve, _curve(history, room_type))
-    summary = _summary(history, run_, room_type, len(train_g), len(held_g), device, preset)
+    summary = _summary(history, run_, room_type, (len(train_g), len(val_g), len(held_g)), test, device, preset)
     tables.write_json(out_summary, summary)
     return summary
 
 
-def _summary(history, run_, room_type, n_train, n_held, device, preset) -> dict:
+def heldout_scores(model, held, vocab, preset: dict, max_edges: int, seed: int, device: str) -> dict:
+    """The chosen weights' NLL on the held-out (test) graphs, once after training: per graph and per decision."""
+    from ..learn import train
+    from ..learn.teacher import KINDS
+
+    model.eval()
+    nll = train.heldout_nll(model, held, vocab, seed, max_edges, preset["batch_size"], device)
+    return {"per_graph": round(float(nll.sum(1).mean()), 4),
+            **{k: round(float(nll[:, i].mean()), 4) for i, k in enumerate(KINDS)}}
+
+
+def _summary(history, run_, room_type, sizes, test, device, preset) -> dict:
     elapsed = history["seconds"].cumsum()
-    best = float(history["heldout_nll"].min())
-    within = history.index[history["heldout_nll"] <= best * 1.02]
-    return {"room_type": room_type, "train_graphs": n_train, "heldout_graphs": n_held, "device": device,
-            "preset": preset, "epochs": int(len(history)), "best_epoch": int(run_.best_epoch),
-            "best_heldout_nll": round(best, 4), "train_seconds": round(float(elapsed.iloc[-1]), 1),
+    best = float(history["validation_nll"].min())
+    within = history.index[history["validation_nll"] <= best * 1.02]
+    return {"room_type": room_type, "train_graphs": sizes[0], "validation_graphs": sizes[1], "heldout_graphs": sizes[2],
+            "device": device, "preset": preset, "epochs": int(len(history)), "best_epoch": int(run_.best_epoch),
+            "best_validation_nll": round(best, 4), "heldout_nll": test["per_graph"],
+            "train_seconds": round(float(elapsed.iloc[-1]), 1),
             "seconds_to_within_2pct_of_best": round(float(elapsed.iloc[within[0]]), 1),
             "graphs_per_s": round(float(history["graphs_per_s"].median()), 1),
             "edges_dropped_per_epoch": int(history["edges_dropped"].iloc[-1]), "resumed_from_epoch": run_.resumed_from}
@@ -88,7 +115,7 @@ def _curve(history, room_type: str):
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     ax.plot(history["epoch"], history["train_nll"], label="train")
-    ax.plot(history["epoch"], history["heldout_nll"], label="held-out")
+    ax.plot(history["epoch"], history["validation_nll"], label="validation")
     ax.set(xlabel="epoch", ylabel="NLL per graph (nats)", title=f"graph model, {room_type}")
     ax.legend()
     fig.tight_layout()
