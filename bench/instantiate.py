@@ -76,8 +76,7 @@ def probe_networks(cfg, room_type: str, saved: dict, probes: int, checker) -> di
 
 def evaluation_collisions(room, parent: dict, checker, ev: dict):
     """``(n,)`` bool: the placed room's objects the evaluation's own test finds colliding."""
-    mesh = [None if m in checker.box_models else checker.meshes.get(m) for m in room.model_ids]
-    return physical.colliding(room, [parent.get(i) for i in room.object_ids], mesh, ev)
+    return physical.colliding(room, [parent.get(i) for i in room.object_ids], checker.meshes_of(room), ev)
 
 
 def main() -> None:

@@ -59,6 +59,11 @@ def heldout_nll(model: GraphModel, graphs: list[Graph], vocab: Vocab, seed: int,
     return np.concatenate(out) if out else np.zeros((0, len(KINDS)))
 
 
+def mean_nll(nll: np.ndarray) -> dict:
+    """Means of a :func:`heldout_nll` array: ``per_graph`` (summed over decisions) and one per decision kind."""
+    return {"per_graph": float(nll.sum(1).mean()), **{k: float(nll[:, i].mean()) for i, k in enumerate(KINDS)}}
+
+
 def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) -> tuple[float, int]:
     """One pass over the training graphs in batches; returns the mean NLL per graph and edges dropped."""
     rng = np.random.default_rng([seed, epoch])
@@ -103,9 +108,9 @@ def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, pres
         train_nll, dropped = _epoch(model, opt, train_graphs, vocab, seed, epoch, preset, max_edges, device)
         seconds = time.perf_counter() - start
         model.eval()
-        val_nll = heldout_nll(model, validation, vocab, seed, max_edges, preset["batch_size"], device)
-        row = {"epoch": epoch, "train_nll": train_nll, "validation_nll": float(val_nll.sum(1).mean()),
-               **{f"validation_{k}": float(val_nll[:, i].mean()) for i, k in enumerate(KINDS)},
+        val = mean_nll(heldout_nll(model, validation, vocab, seed, max_edges, preset["batch_size"], device))
+        row = {"epoch": epoch, "train_nll": train_nll, "validation_nll": val["per_graph"],
+               **{f"validation_{k}": val[k] for k in KINDS},
                "seconds": seconds, "graphs_per_s": len(train_graphs) / max(seconds, 1e-9), "edges_dropped": dropped}
         state["history"].append(row)
         if row["validation_nll"] < state["best"] * (1 - preset["min_improvement"]):

@@ -44,6 +44,10 @@ class Checker:
     intersector: type
     cfg: dict
 
+    def meshes_of(self, room: RoomInput) -> list:
+        """Each object's ``(vertices, faces)``, or None where it is measured as its box."""
+        return [None if m in self.box_models else self.meshes.get(m) for m in room.model_ids]
+
     def extract(self, room: RoomInput):
         return extract_room(room, self.meshes.get, lambda c, m: (self.symmetry.get(m, "none"), "table"),
                             self.extract_cfg, self.intersector, self.box_models)
@@ -62,8 +66,7 @@ def collision(room: RoomInput, k: int, related: set[int], checker: Checker) -> t
     row = boxes.penetration_depths(room.boxes)[k]
     row[list(related)] = 0.0
     depth[k], depth[:, k] = row, row
-    objs = {"meshes": [None if m in checker.box_models else checker.meshes.get(m) for m in room.model_ids],
-            "poses": room.poses}
+    objs = {"meshes": checker.meshes_of(room), "poses": room.poses}
     cfg = {"penetration": checker.cfg["penetration"], "max_penetration": checker.cfg["collision"],
            "intersector": checker.intersector, "confirm": checker.cfg.get("confirm")}
     hit = deepest_penetration(depth, objs, cfg)

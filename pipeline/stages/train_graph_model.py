@@ -86,12 +86,10 @@ def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path,
 def heldout_scores(model, held, vocab, preset: dict, max_edges: int, seed: int, device: str) -> dict:
     """The chosen weights' NLL on the held-out (test) graphs, once after training: per graph and per decision."""
     from ..learn import train
-    from ..learn.teacher import KINDS
 
     model.eval()
     nll = train.heldout_nll(model, held, vocab, seed, max_edges, preset["batch_size"], device)
-    return {"per_graph": round(float(nll.sum(1).mean()), 4),
-            **{k: round(float(nll[:, i].mean()), 4) for i, k in enumerate(KINDS)}}
+    return {k: round(v, 4) for k, v in train.mean_nll(nll).items()}
 
 
 def _summary(history, run_, room_type, sizes, test, device, preset) -> dict:
