@@ -312,3 +312,34 @@ def test_a_reflex_corner_piercing_a_footprint_is_out_of_bounds_for_the_check_and
     assert not verdicts[0].ok and verdicts[0].reason.startswith("outside the floor"), verdicts[0].reason
     assert flags == [True, False]
     assert verdicts[1].ok, verdicts[1].reason
+
+
+def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_only_then():
+    torch = pytest.importorskip("torch")
+    from pipeline.learn.placement_proposer import NetProposer
+    from pipeline.learn.placement_train import build
+    from pipeline.placement.search import Grid, anchors_of
+
+    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
+    plan = bedroom_plan()
+    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
+                      catalog, checker, ic, 0)
+    bed_only = with_objects(out.room, [out.room.object_ids.index("bed")])
+    preset = default_config()["placement"]["presets"]["tiny"]
+    cats = ("bed", "nightstand", "table_lamp")
+    torch.manual_seed(0)
+    loc, ori = build(preset, cats, True)
+    nets = NetProposer({"categories": cats, "preset": preset, "nets": [loc.state_dict(), ori.state_dict()]}, cache_size=1)
+    points = Grid(room.outline, 0.1).points
+    anchors = anchors_of("ns_l", plan, bed_only, walls, {"bed": "left-right"})
+    first = nets.density(bed_only, walls, "nightstand", anchors, points)
+    rebuilt = with_objects(out.room, [out.room.object_ids.index("bed")])  # new arrays, the same content
+    assert rebuilt.boxes is not bed_only.boxes
+    assert nets.density(rebuilt, walls, "nightstand", anchors, points) is first
+    assert (nets.densities.computed, nets.densities.reused) == (1, 1)
+    moved = with_objects(rebuilt, [0])
+    moved.boxes[0, 0] += 0.3  # the bed 30 cm to the side: its anchors' maps move with it
+    shifted = nets.density(moved, walls, "nightstand", anchors_of("ns_l", plan, moved, walls, {"bed": "left-right"}), points)
+    assert nets.densities.computed == 2 and not np.allclose(shifted, first)
+    again = nets.density(bed_only, walls, "nightstand", anchors, points)  # evicted (size 1): computed afresh, equal
+    assert nets.densities.computed == 3 and again is not first and np.array_equal(again, first)

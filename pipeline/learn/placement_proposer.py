@@ -1,6 +1,10 @@
 """The trained networks as a search proposer: location densities from the CFCN (per anchor: summed over its
-symmetry-equivalent frames; across anchors: multiplied), orientations sampled from the orientation network."""
+symmetry-equivalent frames; across anchors: multiplied; kept by the room's content, so that a backtrack finds an
+earlier room's densities again), orientations sampled from the orientation network."""
 from __future__ import annotations
+
+import hashlib
+from collections import OrderedDict
 
 import numpy as np
 import torch
@@ -14,8 +18,39 @@ from .placement_train import build, views
 FLOOR = 1e-3  # an anchor's map never drops below this share of its peak (a window may miss part of the room)
 
 
+def room_key(room: RoomInput, walls: Walls, *parts, arrays: tuple = ()) -> bytes:
+    """A digest of a room's content (ids, categories, boxes, outline, walls, openings) and of ``parts`` (reprs)
+    and ``arrays``. Backtracking returns to earlier rooms as new objects with the same content: keyed this way,
+    what the networks computed for them is found again."""
+    h = hashlib.blake2b(digest_size=16)
+    for part in (room.room_id, room.object_ids, room.categories, room.openings, *parts):
+        h.update(repr(part).encode())
+    for arr in (room.boxes, room.outline, walls.a, walls.b, walls.thickness, *arrays):
+        h.update(np.ascontiguousarray(arr, float).tobytes())
+    return h.digest()
+
+
+class Memo:
+    """The ``size`` most recently used results by key; ``computed`` and ``reused`` count misses and hits."""
+
+    def __init__(self, size: int):
+        self.size, self.computed, self.reused = size, 0, 0
+        self._items: OrderedDict = OrderedDict()
+
+    def get(self, key: bytes, compute):
+        if key in self._items:
+            self._items.move_to_end(key)
+            self.reused += 1
+            return self._items[key]
+        self.computed += 1
+        out = self._items[key] = compute()
+        if len(self._items) > self.size:
+            self._items.popitem(last=False)
+        return out
+
+
 class NetProposer:
-    def __init__(self, saved: dict, film: bool = True, device: str = "cpu"):
+    def __init__(self, saved: dict, film: bool = True, device: str = "cpu", cache_size: int = 256):
         self.categories = tuple(saved["categories"])
         self.preset = saved["preset"]
         self.loc, self.ori = build(self.preset, self.categories, film)
@@ -25,7 +60,7 @@ class NetProposer:
         self.ori.eval()
         self.loc_view, self.ori_view = views(self.preset, self.categories)
         self.device = device
-        self._cache: dict = {}
+        self.densities = Memo(cache_size)  # exact: keyed on content
 
     def _maps(self, room: RoomInput, walls: Walls, anchors) -> list[tuple[list, np.ndarray]]:
         """Per anchor: its frames and the ``(frames, categories + 1, s, s)`` softmax maps."""
@@ -47,10 +82,9 @@ class NetProposer:
     def density(self, room: RoomInput, walls: Walls, category: str, anchors, points: np.ndarray) -> np.ndarray:
         if not anchors or category not in self.categories:
             return np.ones(len(points))
-        key = (id(room.boxes), len(room.object_ids), category, tuple((a.node, a.direction, a.distance) for a in anchors))
-        if key not in self._cache:
-            self._cache = {key: self._density(room, walls, category, anchors, points)}
-        return self._cache[key]
+        key = room_key(room, walls, category, [(a.node, a.obj, a.wall, a.symmetry, a.direction, a.distance) for a in anchors],
+                       arrays=(points,))
+        return self.densities.get(key, lambda: self._density(room, walls, category, anchors, points))
 
     def _density(self, room, walls, category, anchors, points) -> np.ndarray:
         c = self.categories.index(category) + 1
