@@ -15,10 +15,10 @@ from pipeline.geometry.polygon import outside_area
 from pipeline.geometry.raycast import intersector_class
 from pipeline.placement import export, order, scene_metrics
 from pipeline.placement.checks import Checker
-from pipeline.placement.layout import View, render, walls_of, with_objects
+from pipeline.placement.layout import View, add_object, render, walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
-from pipeline.placement.retrieval import Catalog
+from pipeline.placement.retrieval import Catalog, place
 from pipeline.placement.search import instantiate
 
 SIZES = {"bed": (1.6, 2.0, 0.5), "nightstand": (0.5, 0.4, 0.55), "table_lamp": (0.2, 0.2, 0.4),
@@ -343,3 +343,30 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
     assert nets.densities.computed == 2 and not np.allclose(shifted, first)
     again = nets.density(bed_only, walls, "nightstand", anchors, points)  # evicted (size 1): computed afresh, equal
     assert nets.densities.computed == 3 and again is not first and np.array_equal(again, first)
+
+
+def _desk_right_of_a_wardrobe_flush_with_the_wall(early: bool):
+    """A given wardrobe whose right side touches the right wall, and a desk planned adjacent to that side."""
+    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"], max_backtracks=8, early_backtrack=early)
+    inst = catalog.pick("wardrobe", "left-right", np.random.default_rng(0))
+    box, pose = place(inst, 4.0 - inst.half[0], 1.75, None, 0.0)  # yaw 0: its right side faces +x, on the wall
+    room = add_object(room, "w", "wardrobe", inst.model_id, box, pose)
+    plan = ScenePlan("s3", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1],
+                     [None, None], ["none", "none"], [PlanEdge("w", "d", "spatial", "right", "adjacent")])
+    return instantiate(plan, room, walls, [1], Combined(RelationPrior(soft=1e-3), FaceAway()), catalog, checker, ic, 0)
+
+
+def test_early_backtrack_skips_the_samples_of_an_object_no_band_leaves_a_cell_for():
+    drawn, early = _desk_right_of_a_wardrobe_flush_with_the_wall(False), _desk_right_of_a_wardrobe_flush_with_the_wall(True)
+    assert "nowhere" not in drawn.failures and drawn.failures.get("violates", 0) >= 2 * 3  # tolerance 0: all break it
+    assert early.failures["nowhere"] == 3  # backtracks 0-2 of 8 are at zero tolerance (it grows from 0 at 2); then it samples
+    assert early.rejections < drawn.rejections and early.backtracks == drawn.backtracks == 8
+
+
+def test_early_backtrack_still_places_the_hand_built_bedroom_with_every_planned_edge():
+    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"], early_backtrack=True)
+    plan = bedroom_plan()
+    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
+                      catalog, checker, ic, 0)
+    assert out.ok, out.reason
+    assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0

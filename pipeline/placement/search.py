@@ -26,6 +26,7 @@ from .checks import Checker, check
 from .layout import add_object, box_frame, wall_frame, with_objects
 from .order import chains
 from .plan import PlanEdge, ScenePlan
+from .proposers import RelationPrior
 from .retrieval import Catalog, place
 
 log = logging.getLogger("planit.instantiate")
@@ -209,6 +210,23 @@ class Search:
             out |= _in_box(self.grid.points, g)
         return out
 
+    def band_cells(self, anchors: list[Anchor], half: tuple[float, float]) -> np.ndarray:
+        """``(cells,)`` free floor cells (off placed floor objects grown by the smaller of ``half``) inside every
+        anchor's planned band (:class:`~pipeline.placement.proposers.RelationPrior`, no softness)."""
+        free = self.grid.floor & ~self.occupied(min(half))
+        return free & (RelationPrior().density(self.room, self.walls, "", anchors, self.grid.points) > 0)
+
+    def nowhere(self, k: int, tol: float) -> set[str] | None:
+        """With ``early_backtrack``, at zero tolerance: the placed objects among floor object ``k``'s anchors when
+        no free cell lies in every planned band (its samples would almost all break a relation), else None."""
+        if not self.cfg["early_backtrack"] or tol > 0 or self.plan.parent[k] is not None:
+            return None
+        half = self.model_for(k).half[:2]
+        anchors = anchors_of(self.plan.ids[k], self.plan, self.room, self.walls, self.sym, half)
+        if not anchors or self.band_cells(anchors, half).any():
+            return None
+        return {a.node for a in anchors if a.obj is not None}
+
     def propose(self, k: int, half: float):
         """A candidate box and pose for object ``k``, or None when no location has mass left. A supported object
         turns first (to its support's axes) so that its footprint can be kept on the support's top."""
@@ -252,6 +270,11 @@ class Search:
         budget = max(self.cfg["min_samples"], self.cfg["samples"] - self.backtracks // 5)
         half = min(self.cfg["reject_half"] * self.cfg["reject_growth"] ** self.backtracks, self.cfg["reject_max_half"])
         tol = tolerance(self.backtracks, self.cfg["max_backtracks"])
+        blocked = self.nowhere(k, tol)
+        if blocked is not None:
+            log.debug("%s %s: no free cell in every planned band", self.plan.scene_id, v)
+            self.failures["nowhere"] = self.failures.get("nowhere", 0) + 1
+            return blocked
         for _ in range(budget):
             cand = self.propose(k, half)
             if cand is None:
