@@ -42,7 +42,7 @@ def probe_networks(cfg, room_type: str, saved: dict, probes: int, checker) -> di
     _, _, held, _ = train_placement.training_rooms(cfg, room_type, p["rooms"], p["architecture"], p["objects"],
                                                    ROOT / "results/graphs/ingested/nodes.parquet",
                                                    ROOT / "results/graphs/ingested/edges.parquet")
-    net, rng = NetProposer(saved), np.random.default_rng(0)
+    net, rng = NetProposer(saved, cfg["instantiate"]["density_cache"]), np.random.default_rng(0)
     near, net_hits, rule_hits, n = [], 0, 0, 0
     for t in (held[int(rng.integers(len(held)))] for _ in range(probes)):
         room = t.room

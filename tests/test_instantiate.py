@@ -329,7 +329,7 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
     cats = ("bed", "nightstand", "table_lamp")
     torch.manual_seed(0)
     loc, ori = build(preset, cats, True)
-    nets = NetProposer({"categories": cats, "preset": preset, "nets": [loc.state_dict(), ori.state_dict()]}, cache_size=1)
+    nets = NetProposer({"categories": cats, "preset": preset, "nets": [loc.state_dict(), ori.state_dict()]}, 1)
     points = Grid(room.outline, 0.1).points
     anchors = anchors_of("ns_l", plan, bed_only, walls, {"bed": "left-right"})
     first = nets.density(bed_only, walls, "nightstand", anchors, points)

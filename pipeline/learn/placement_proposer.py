@@ -50,7 +50,7 @@ class Memo:
 
 
 class NetProposer:
-    def __init__(self, saved: dict, film: bool = True, device: str = "cpu", cache_size: int = 256):
+    def __init__(self, saved: dict, cache_size: int, film: bool = True, device: str = "cpu"):
         self.categories = tuple(saved["categories"])
         self.preset = saved["preset"]
         self.loc, self.ori = build(self.preset, self.categories, film)
@@ -60,7 +60,7 @@ class NetProposer:
         self.ori.eval()
         self.loc_view, self.ori_view = views(self.preset, self.categories)
         self.device = device
-        self.densities = Memo(cache_size)  # exact: keyed on content
+        self.densities = Memo(cache_size)  # exact: keyed on content (instantiate.density_cache entries)
 
     def _maps(self, room: RoomInput, walls: Walls, anchors) -> list[tuple[list, np.ndarray]]:
         """Per anchor: its frames and the ``(frames, categories + 1, s, s)`` softmax maps."""

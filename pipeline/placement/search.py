@@ -5,7 +5,8 @@ floor or its support's top, minus squares around the points already rejected), a
 slides flush against the anchors it must be adjacent to, then must pass :func:`~pipeline.placement.checks.check`.
 After its sample budget, the search backtracks to the nearest earlier object that caused one of its failures (or
 the one before it) and that object is placed afresh elsewhere. The relation tolerance stays 0 for the first
-quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``. A scene fails, with its reason,
+quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``. With ``early_backtrack``, an object at zero
+tolerance whose planned bands share no free cell backtracks at once instead of spending its samples. A scene fails, with its reason,
 when the backtrack or time budget runs out, or an object's category has no training instance; with
 ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search goes on.
 """
@@ -210,11 +211,15 @@ class Search:
             out |= _in_box(self.grid.points, g)
         return out
 
-    def band_cells(self, anchors: list[Anchor], half: tuple[float, float]) -> np.ndarray:
-        """``(cells,)`` free floor cells (off placed floor objects grown by the smaller of ``half``) inside every
-        anchor's planned band (:class:`~pipeline.placement.proposers.RelationPrior`, no softness)."""
-        free = self.grid.floor & ~self.occupied(min(half))
-        return free & (RelationPrior().density(self.room, self.walls, "", anchors, self.grid.points) > 0)
+    def free_floor(self, half) -> np.ndarray:
+        """``(cells,)`` candidate centres on the floor and off the placed floor objects grown by the smaller of an
+        object's half extents ``half (2,)``."""
+        return self.grid.floor & ~self.occupied(min(half))
+
+    def band_cells(self, anchors: list[Anchor], half) -> np.ndarray:
+        """``(cells,)`` :meth:`free_floor` cells inside every anchor's planned band
+        (:class:`~pipeline.placement.proposers.RelationPrior`, no softness)."""
+        return self.free_floor(half) & (RelationPrior().density(self.room, self.walls, "", anchors, self.grid.points) > 0)
 
     def nowhere(self, k: int, tol: float) -> set[str] | None:
         """With ``early_backtrack``, at zero tolerance: the placed objects among floor object ``k``'s anchors when
@@ -236,7 +241,7 @@ class Search:
         parent = self.plan.parent[k]
         pk = self.room.object_ids.index(parent) if parent in self.room.object_ids else None
         if pk is None:  # on the floor, off the floor objects' footprints
-            mask, yaw = self.grid.floor & ~self.occupied(min(inst.half[:2])), None
+            mask, yaw = self.free_floor(inst.half[:2]), None
         else:
             pb = self.room.boxes[pk]
             yaw = self.proposer.orientation(self.room, self.walls, cat, sym, pb[:2], self.rng)

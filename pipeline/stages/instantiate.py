@@ -68,7 +68,7 @@ def make_proposer(location: str, saved: dict, cfg: dict):
     rule-band locations; orientations from the network. ``cfg``: the instantiate section."""
     from ..learn.placement_proposer import NetProposer
 
-    nets = NetProposer(saved, film=location == "cfcn", cache_size=cfg["density_cache"])
+    nets = NetProposer(saved, cfg["density_cache"], film=location == "cfcn")
     if location in ("cfcn", "fcn"):
         bands = proposers.RelationPrior(soft=cfg["band_softness"])
         return proposers.Masked(nets, bands) if cfg["relation_mask"] else nets
