@@ -2,7 +2,9 @@
 (support and adjacent edges) placed again by the search with the relation-band proposer, no network, then
 extracted again: rooms placed, graph consistency, seconds per room.
 
-    .venv/bin/python bench/front3d_instantiate.py [--sample ../shared/data/3d-front-meshes]
+    .venv/bin/python bench/front3d_instantiate.py [--sample ../shared/data/3d-front-meshes] [--early-backtrack]
+
+``--early-backtrack``: with ``instantiate.early_backtrack`` on (off by default).
 """
 from __future__ import annotations
 
@@ -21,10 +23,12 @@ from common import OUT, ROOT, arguments, report
 def main() -> None:
     ap = arguments(__doc__, OUT / "front3d_instantiate")
     ap.add_argument("--sample", type=Path, default=ROOT.parent / "shared" / "data" / "3d-front-meshes")
+    ap.add_argument("--early-backtrack", action="store_true")
     args = ap.parse_args()
     w = args.workdir
     cfg = config_mod.validate({"source": "front3d", "shards": 1, "front3d": {
-        "houses": str(args.sample / "houses"), "future": str(args.sample / "3d-future"), "cache_dir": str(w / "cache")}})
+        "houses": str(args.sample / "houses"), "future": str(args.sample / "3d-future"), "cache_dir": str(w / "cache")},
+        "instantiate": {"early_backtrack": args.early_backtrack}})
     ing = w / "ingest"
     outs = {t: ing / f"{t}-0.parquet" for t in ingest.OUTPUTS}
     ingest.run(cfg, 0, outs)
@@ -38,7 +42,8 @@ def main() -> None:
     rows = reinstantiate(t["rooms"], t["architecture"], t["objects"], meshes, box_models, sym, cfg, plans)
     for r in rows:
         print(r["room_id"], r["objects"], "placed" if r["placed"] else r["reason"], f"{r['consistency']:.3f}", f"{r['seconds']:.1f} s")
-    report({**summary(rows), "sample": str(args.sample)}, w, "front3d_instantiate")
+    report({**summary(rows), "sample": str(args.sample), "early_backtrack": args.early_backtrack}, w,
+           "front3d_instantiate" + ("_early_backtrack" if args.early_backtrack else ""))
 
 
 if __name__ == "__main__":
