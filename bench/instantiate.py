@@ -3,10 +3,13 @@ good the placement networks are on held-out rooms (location: CFCN mass near the 
 network's most likely bin against the face-away-from-the-wall rule).
 
     .venv/bin/python bench/instantiate.py [--room-type bedroom] [--scenes 30] [--probes 60] [--no-confirm]
+        [--early-backtrack] [--density-cache N]
 
 ``--no-confirm``: the collision check on the coarse per-attempt grid alone, without measuring the pairs it clears
 again on the evaluation's grid (what the search did before); either way the placed rooms' colliding objects are
-counted by the evaluation's own test.
+counted by the evaluation's own test. ``--early-backtrack``: with ``instantiate.early_backtrack`` on (off by
+default). ``--density-cache N``: keep N location densities (1: only the room at hand, what a backtrack loses); the
+report counts the densities computed and found again.
 
 Reads a pipeline run's outputs (make pipeline first): the sampled graphs, the corpus tables and
 results/placement/<type>/cfcn/model.pt.
@@ -85,9 +88,14 @@ def main() -> None:
     ap.add_argument("--scenes", type=int, default=30)
     ap.add_argument("--probes", type=int, default=60)
     ap.add_argument("--no-confirm", action="store_true")
+    ap.add_argument("--early-backtrack", action="store_true")
+    ap.add_argument("--density-cache", type=int)
     args = ap.parse_args()
     torch.set_num_threads(1)
     cfg = config_mod.load(ROOT / "config" / "config.yaml")
+    cfg["instantiate"]["early_backtrack"] = args.early_backtrack
+    if args.density_cache:
+        cfg["instantiate"]["density_cache"] = args.density_cache
     saved = torch.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", map_location="cpu", weights_only=False)
     p = generate.corpus_paths(cfg)
     ctx = instantiate.load_context(cfg, args.room_type, saved, p["rooms"], p["architecture"], p["objects"], p["models"],
@@ -98,23 +106,29 @@ def main() -> None:
     graphs = ROOT / "results/graph_model" / args.room_type / "sampled"
     plans = instantiate.select_plans(cfg, variant, ctx, graphs / "nodes.parquet", graphs / "edges.parquet", args.scenes)
     proposer = instantiate.make_proposer("cfcn", saved, cfg["instantiate"])
+    nets = getattr(proposer, "base", proposer)  # the NetProposer, under the relation bands when they are on
     rows, colliding, ev = [], 0, {**cfg["evaluate"]["collision"], "intersector": ctx.checker.intersector}
     for plan in plans:
         seed = zlib.crc32(f"{cfg['seed']}/bench/{plan.scene_id}".encode())
         out, walls = instantiate.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
-        rows.append((out.ok, out.seconds, scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker)["consistency"]))
+        rows.append((out.ok, out.seconds, scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker)["consistency"],
+                     out.rejections, out.failures.get("nowhere", 0)))
         if out.ok:
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())
     placed = [r for r in rows if r[0]]
     result = {"room_type": args.room_type, "scenes": len(rows), "placed": len(placed),
               "confirm_on_evaluation_grid": not args.no_confirm, "search_seconds": round(sum(r[1] for r in rows), 1),
-              "colliding_objects_by_evaluation": colliding,
+              "colliding_objects_by_evaluation": colliding, "early_backtrack": args.early_backtrack,
+              "rejections_per_scene": round(float(np.mean([r[3] for r in rows])), 1),
+              "early_backtracks": sum(r[4] for r in rows), "density_cache": cfg["instantiate"]["density_cache"],
+              "densities_computed": nets.densities.computed, "densities_reused": nets.densities.reused,
               "median_seconds_per_scene": round(statistics.median(r[1] for r in rows), 3),
               "median_seconds_placed": round(statistics.median(r[1] for r in placed), 3) if placed else None,
               "mean_consistency_placed": round(float(np.mean([r[2] for r in placed])), 4) if placed else None,
               **probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker),
               "machine": platform.processor() or platform.machine(), "threads": 1}
-    report(result, args.workdir, f"instantiate_{args.room_type}" + ("_no_confirm" if args.no_confirm else ""))
+    report(result, args.workdir, f"instantiate_{args.room_type}" + ("_no_confirm" if args.no_confirm else "")
+           + ("_early_backtrack" if args.early_backtrack else "") + (f"_cache{args.density_cache}" if args.density_cache else ""))
 
 
 if __name__ == "__main__":
