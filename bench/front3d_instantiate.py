@@ -2,12 +2,13 @@
 (support and adjacent edges) placed again by the search with the relation-band proposer, no network, then
 extracted again: rooms placed, graph consistency, seconds per room.
 
-    .venv/bin/python bench/front3d_instantiate.py [--sample ../shared/data/3d-front-meshes] [--early-backtrack]
+    .venv/bin/python bench/front3d_instantiate.py [--sample ../shared/data/3d-front-meshes] [--[no-]early-backtrack]
 
-``--early-backtrack``: with ``instantiate.early_backtrack`` on (off by default).
+``--[no-]early-backtrack``: sets ``instantiate.early_backtrack`` (default: the schema's, on).
 """
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 import pandas as pd
@@ -23,12 +24,12 @@ from common import OUT, ROOT, arguments, report
 def main() -> None:
     ap = arguments(__doc__, OUT / "front3d_instantiate")
     ap.add_argument("--sample", type=Path, default=ROOT.parent / "shared" / "data" / "3d-front-meshes")
-    ap.add_argument("--early-backtrack", action="store_true")
+    ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
     args = ap.parse_args()
     w = args.workdir
     cfg = config_mod.validate({"source": "front3d", "shards": 1, "front3d": {
         "houses": str(args.sample / "houses"), "future": str(args.sample / "3d-future"), "cache_dir": str(w / "cache")},
-        "instantiate": {"early_backtrack": args.early_backtrack}})
+        "instantiate": {} if args.early_backtrack is None else {"early_backtrack": args.early_backtrack}})
     ing = w / "ingest"
     outs = {t: ing / f"{t}-0.parquet" for t in ingest.OUTPUTS}
     ingest.run(cfg, 0, outs)
@@ -42,8 +43,8 @@ def main() -> None:
     rows = reinstantiate(t["rooms"], t["architecture"], t["objects"], meshes, box_models, sym, cfg, plans)
     for r in rows:
         print(r["room_id"], r["objects"], "placed" if r["placed"] else r["reason"], f"{r['consistency']:.3f}", f"{r['seconds']:.1f} s")
-    report({**summary(rows), "sample": str(args.sample), "early_backtrack": args.early_backtrack}, w,
-           "front3d_instantiate" + ("_early_backtrack" if args.early_backtrack else ""))
+    report({**summary(rows), "sample": str(args.sample), "early_backtrack": cfg["instantiate"]["early_backtrack"]}, w,
+           "front3d_instantiate" + {True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack])
 
 
 if __name__ == "__main__":

@@ -3,12 +3,12 @@ good the placement networks are on held-out rooms (location: CFCN mass near the 
 network's most likely bin against the face-away-from-the-wall rule).
 
     .venv/bin/python bench/instantiate.py [--room-type bedroom] [--scenes 30] [--probes 60] [--no-confirm]
-        [--early-backtrack] [--density-cache N]
+        [--early-backtrack | --no-early-backtrack] [--restarts N] [--density-cache N]
 
 ``--no-confirm``: the collision check on the coarse per-attempt grid alone, without measuring the pairs it clears
 again on the evaluation's grid (what the search did before); either way the placed rooms' colliding objects are
-counted by the evaluation's own test. ``--early-backtrack``: with ``instantiate.early_backtrack`` on (off by
-default). ``--density-cache N``: keep N location densities (1: only the room at hand, what a backtrack loses); the
+counted by the evaluation's own test. ``--[no-]early-backtrack`` and ``--restarts N`` set
+``instantiate.early_backtrack`` and ``instantiate.restarts`` (default: the config's). ``--density-cache N``: keep N location densities (1: only the room at hand, what a backtrack loses); the
 report counts the densities computed and found again.
 
 Reads a pipeline run's outputs (make pipeline first): the sampled graphs, the corpus tables and
@@ -16,6 +16,7 @@ results/placement/<type>/cfcn/model.pt.
 """
 from __future__ import annotations
 
+import argparse
 import platform
 import statistics
 import zlib
@@ -88,12 +89,15 @@ def main() -> None:
     ap.add_argument("--scenes", type=int, default=30)
     ap.add_argument("--probes", type=int, default=60)
     ap.add_argument("--no-confirm", action="store_true")
-    ap.add_argument("--early-backtrack", action="store_true")
+    ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
+    ap.add_argument("--restarts", type=int)
     ap.add_argument("--density-cache", type=int)
     args = ap.parse_args()
     torch.set_num_threads(1)
     cfg = config_mod.load(ROOT / "config" / "config.yaml")
-    cfg["instantiate"]["early_backtrack"] = args.early_backtrack
+    for key in ("early_backtrack", "restarts"):
+        if getattr(args, key) is not None:
+            cfg["instantiate"][key] = getattr(args, key)
     if args.density_cache:
         cfg["instantiate"]["density_cache"] = args.density_cache
     saved = torch.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", map_location="cpu", weights_only=False)
@@ -112,13 +116,15 @@ def main() -> None:
         seed = zlib.crc32(f"{cfg['seed']}/bench/{plan.scene_id}".encode())
         out, walls = instantiate.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
         rows.append((out.ok, out.seconds, scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker)["consistency"],
-                     out.rejections, out.failures.get("nowhere", 0)))
+                     out.rejections, out.failures.get("nowhere", 0), out.attempts))
         if out.ok:
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())
     placed = [r for r in rows if r[0]]
     result = {"room_type": args.room_type, "scenes": len(rows), "placed": len(placed),
               "confirm_on_evaluation_grid": not args.no_confirm, "search_seconds": round(sum(r[1] for r in rows), 1),
-              "colliding_objects_by_evaluation": colliding, "early_backtrack": args.early_backtrack,
+              "colliding_objects_by_evaluation": colliding, "early_backtrack": cfg["instantiate"]["early_backtrack"],
+              "restarts": cfg["instantiate"]["restarts"], "restarted_scenes": sum(r[5] > 1 for r in rows),
+              "attempts": sum(r[5] for r in rows),
               "rejections_per_scene": round(float(np.mean([r[3] for r in rows])), 1),
               "early_backtracks": sum(r[4] for r in rows), "density_cache": cfg["instantiate"]["density_cache"],
               "densities_computed": nets.densities.computed, "densities_reused": nets.densities.reused,
@@ -128,7 +134,9 @@ def main() -> None:
               **probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker),
               "machine": platform.processor() or platform.machine(), "threads": 1}
     report(result, args.workdir, f"instantiate_{args.room_type}" + ("_no_confirm" if args.no_confirm else "")
-           + ("_early_backtrack" if args.early_backtrack else "") + (f"_cache{args.density_cache}" if args.density_cache else ""))
+           + {True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
+           + (f"_restarts{args.restarts}" if args.restarts is not None else "")
+           + (f"_cache{args.density_cache}" if args.density_cache else ""))
 
 
 if __name__ == "__main__":

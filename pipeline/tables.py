@@ -210,6 +210,7 @@ SCHEMAS["scenes"] = pa.schema([
     _f("seconds", _F64, "s"), _f("planned_objects", _I32), _f("placed_objects", _I32),
     _f("insertions", _I32, doc="accepted placements, those undone by backtracking included"),
     _f("rejections", _I32, doc="candidates that failed a check"), _f("backtracks", _I32),
+    _f("attempts", _I32, doc="searches from scratch: 1 + the restarts used (instantiate.restarts); the counts add up over them"),
     _f("failures", _STR, doc="JSON: rejections per check (outside, overhangs, collides, violates)"),
     _f("planned_edges", _I32, doc="planned support and spatial edges between placed nodes"),
     _f("found_edges", _I32, doc="of those, found again exactly by extraction"),

@@ -120,11 +120,43 @@ def _unsatisfiable():
 
 
 def test_an_unsatisfiable_graph_ends_with_a_failure_record_not_a_hang():
-    room, walls, catalog, checker, ic = setup(["bed"], NARROW, max_backtracks=6)
+    room, walls, catalog, checker, ic = setup(["bed"], NARROW, max_backtracks=6, restarts=2)
     out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
     assert not out.ok and "backtrack budget (6) spent: no place for b (bed)" in out.reason
-    assert out.backtracks == 6 and out.rejections > 0 and out.room.object_ids == []
+    assert out.attempts == 3 and out.backtracks == 3 * 6  # every restart spent its own budget; the counts add up
+    assert out.rejections > 0 and out.room.object_ids == []
     assert set(out.failures) == {"outside"}
+    once = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), catalog, checker,
+                       {**ic, "restarts": 0}, 0)
+    assert once.attempts == 1 and once.backtracks == 6 and 0 < once.rejections < out.rejections
+
+
+def test_a_scene_whose_first_search_spends_its_budget_is_placed_by_a_restart():
+    """PlantedCorner's one bad proposal sinks the first attempt when no backtrack is allowed; the restart searches
+    from scratch and places the scene with every planned edge."""
+    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"], max_backtracks=0)
+    plan = ScenePlan("s1", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1], [None, None],
+                     ["none", "none"], [PlanEdge("wall_0", "w", "spatial", "front", "adjacent"),
+                                        PlanEdge("wall_0", "d", "spatial", "front", "adjacent"),
+                                        PlanEdge("w", "d", "spatial", "right", "adjacent")])
+    seq = order.placement_order(plan, AREAS)
+    failed = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), catalog, checker,
+                         {**ic, "restarts": 0}, 0)
+    assert not failed.ok and failed.attempts == 1 and "backtrack budget (0) spent: no place for d" in failed.reason
+    out = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), catalog, checker, {**ic, "restarts": 2}, 0)
+    assert out.ok and out.attempts == 2, out.reason
+    assert out.rejections >= failed.rejections  # the failed attempt's rejections are counted too
+    assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
+
+
+def test_restarts_leave_a_scene_placed_at_the_first_attempt_unchanged():
+    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
+    plan = bedroom_plan()
+    seq = order.placement_order(plan, AREAS)
+    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), catalog, checker,
+                        {**ic, "restarts": n}, 1) for n in (0, 3))
+    assert a.ok and b.ok and a.attempts == b.attempts == 1
+    assert np.array_equal(a.room.boxes, b.room.boxes) and a.rejections == b.rejections
 
 
 @pytest.mark.parametrize("mode", ["fail", "drop"])
@@ -347,7 +379,7 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
 
 def _desk_right_of_a_wardrobe_flush_with_the_wall(early: bool):
     """A given wardrobe whose right side touches the right wall, and a desk planned adjacent to that side."""
-    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"], max_backtracks=8, early_backtrack=early)
+    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"], max_backtracks=8, early_backtrack=early, restarts=0)
     inst = catalog.pick("wardrobe", "left-right", np.random.default_rng(0))
     box, pose = place(inst, 4.0 - inst.half[0], 1.75, None, 0.0)  # yaw 0: its right side faces +x, on the wall
     room = add_object(room, "w", "wardrobe", inst.model_id, box, pose)

@@ -42,7 +42,7 @@ def reinstantiate(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.D
                           catalog, checker, ic, seed)
         m = scene_metrics.consistency(plan, out.room, walls.ids, checker)
         rows.append({"room_id": plan.room_id, "objects": len(plan.ids), "placed": out.status == "placed", "reason": out.reason,
-                     "seconds": out.seconds, "backtracks": out.backtracks, **m,
+                     "seconds": out.seconds, "backtracks": out.backtracks, "attempts": out.attempts, **m,
                      "colliding_objects": scene_metrics.colliding_objects(out.room, dict(zip(plan.ids, plan.parent)), checker)})
     return rows
 

@@ -9,6 +9,8 @@ quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``. 
 tolerance whose planned bands share no free cell backtracks at once instead of spending its samples. A scene fails, with its reason,
 when the backtrack or time budget runs out, or an object's category has no training instance; with
 ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search goes on.
+A scene whose backtrack budget runs out starts over from scratch with a fresh seed, at most ``restarts`` times (each
+attempt with its own budgets); its counts add up over the attempts.
 """
 from __future__ import annotations
 
@@ -67,6 +69,7 @@ class Outcome:
     backtracks: int = 0
     failures: dict = field(default_factory=dict)  # reason kind -> count
     dropped: list = field(default_factory=list)  # plan ids left out (on_exhausted: drop), in the order dropped
+    attempts: int = 1  # searches from scratch (1 + restarts used)
 
     @property
     def status(self) -> str:
@@ -187,6 +190,7 @@ class Search:
         self.backtracks = self.rejections = self.insertions = 0
         self.failures: dict[str, int] = {}
         self.dropped: list[str] = []
+        self.exhausted = False  # the backtrack budget ran out (the one failure a restart may cure)
 
     def model_for(self, k: int):
         """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's."""
@@ -328,6 +332,7 @@ class Search:
                     self.dropped.append(self.plan.ids[k])
                     i += 1
                     continue
+                self.exhausted = True
                 return f"backtrack budget ({self.cfg['max_backtracks']}) spent: no place for {self.plan.ids[k]} ({self.plan.categories[k]})"
             self.backtracks += 1
             if i == 0:  # nothing to undo: the first object tries again afresh
@@ -348,13 +353,23 @@ class Search:
 
 def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, catalog: Catalog,
                 checker: Checker, cfg: dict, seed: int) -> Outcome:
-    """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed)."""
-    start = time.perf_counter()
-    s = Search(plan, room, walls, order, proposer, catalog, checker, cfg, np.random.default_rng(seed))
-    reason = s.run(start + cfg["time_budget"])
-    ok = not reason
-    if ok and s.dropped:
-        reason = f"dropped {len(s.dropped)} of {len(order)} objects (no place once the backtrack budget was spent, no " \
-                 f"training model, or their support dropped): {', '.join(s.dropped)}"
-    return Outcome(ok, s.room, reason, time.perf_counter() - start, s.insertions, s.rejections, s.backtracks,
-                   s.failures, s.dropped)
+    """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed). A search that
+    spends its backtrack budget starts over, up to ``cfg['restarts']`` times: attempt ``a > 0`` draws from
+    ``(seed, a)``, so the first attempt is the search without restarts. Counts and seconds add up over attempts."""
+    start, total = time.perf_counter(), Outcome(False, room, attempts=0)
+    for attempt in range(cfg["restarts"] + 1):
+        s = Search(plan, room, walls, order, proposer, catalog, checker, cfg,
+                   np.random.default_rng(seed if attempt == 0 else [seed, attempt]))
+        reason = s.run(time.perf_counter() + cfg["time_budget"])
+        total.attempts += 1
+        total.insertions, total.rejections, total.backtracks = (total.insertions + s.insertions,
+                                                                total.rejections + s.rejections, total.backtracks + s.backtracks)
+        for kind, n in s.failures.items():
+            total.failures[kind] = total.failures.get(kind, 0) + n
+        if not s.exhausted:
+            break
+    total.ok, total.room, total.dropped = not reason, s.room, s.dropped
+    total.reason = reason or (f"dropped {len(s.dropped)} of {len(order)} objects (no place once the backtrack budget "
+                              f"was spent, no training model, or their support dropped): {', '.join(s.dropped)}" if s.dropped else "")
+    total.seconds = time.perf_counter() - start
+    return total

@@ -97,7 +97,8 @@ def scene_rows(plan: ScenePlan, ctx: Context, outcome, walls, variant_name: str)
     record = {"scene_id": plan.scene_id, "room_type": ctx.room_type, "variant": variant_name, "source_room_id": plan.room_id,
               "status": outcome.status, "reason": outcome.reason, "seconds": outcome.seconds,
               "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids), "insertions": outcome.insertions,
-              "rejections": outcome.rejections, "backtracks": outcome.backtracks, "failures": json.dumps(outcome.failures),
+              "rejections": outcome.rejections, "backtracks": outcome.backtracks, "attempts": outcome.attempts,
+              "failures": json.dumps(outcome.failures),
               **metrics, "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
     src = tables.records(ctx.rooms[ctx.rooms["room_id"] == plan.room_id])[0]
     room_row = {**src, "room_id": plan.scene_id, "n_objects": len(room.object_ids), "shard": 0}
@@ -197,6 +198,7 @@ def summarise(scenes: pd.DataFrame) -> dict:
     scored = scenes["status"].isin(SCORED)
     return {"scenes": int(len(scenes)), "placed": int((scenes["status"] == "placed").sum()),
             "partial": int((scenes["status"] == "partial").sum()), "failed": int((~scored).sum()),
+            "restarted": int((scenes["attempts"] > 1).sum()),
             "rejections_per_scene": round(float(scenes["rejections"].mean()), 3),
             "backtracks_per_insertion": round(float(scenes["backtracks"].sum() / max(scenes["insertions"].sum(), 1)), 4),
             "violation": round(float(scenes.loc[scored, "violation"].mean()), 4) if scored.any() else None,
