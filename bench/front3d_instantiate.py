@@ -3,8 +3,10 @@
 extracted again: rooms placed, graph consistency, seconds per room.
 
     .venv/bin/python bench/front3d_instantiate.py [--sample ../shared/data/3d-front-meshes] [--[no-]early-backtrack]
+        [--restarts N]
 
-``--[no-]early-backtrack``: sets ``instantiate.early_backtrack`` (default: the schema's, on).
+``--[no-]early-backtrack`` and ``--restarts N`` set ``instantiate.early_backtrack`` and ``instantiate.restarts``
+(default: the schema's, on and 2).
 """
 from __future__ import annotations
 
@@ -25,11 +27,12 @@ def main() -> None:
     ap = arguments(__doc__, OUT / "front3d_instantiate")
     ap.add_argument("--sample", type=Path, default=ROOT.parent / "shared" / "data" / "3d-front-meshes")
     ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
+    ap.add_argument("--restarts", type=int)
     args = ap.parse_args()
     w = args.workdir
     cfg = config_mod.validate({"source": "front3d", "shards": 1, "front3d": {
         "houses": str(args.sample / "houses"), "future": str(args.sample / "3d-future"), "cache_dir": str(w / "cache")},
-        "instantiate": {} if args.early_backtrack is None else {"early_backtrack": args.early_backtrack}})
+        "instantiate": {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts)) if v is not None}})
     ing = w / "ingest"
     outs = {t: ing / f"{t}-0.parquet" for t in ingest.OUTPUTS}
     ingest.run(cfg, 0, outs)
@@ -43,8 +46,10 @@ def main() -> None:
     rows = reinstantiate(t["rooms"], t["architecture"], t["objects"], meshes, box_models, sym, cfg, plans)
     for r in rows:
         print(r["room_id"], r["objects"], "placed" if r["placed"] else r["reason"], f"{r['consistency']:.3f}", f"{r['seconds']:.1f} s")
-    report({**summary(rows), "sample": str(args.sample), "early_backtrack": cfg["instantiate"]["early_backtrack"]}, w,
-           "front3d_instantiate" + {True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack])
+    ic = cfg["instantiate"]
+    report({**summary(rows), "sample": str(args.sample), "early_backtrack": ic["early_backtrack"], "restarts": ic["restarts"]},
+           w, "front3d_instantiate" + {True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
+           + (f"_restarts{args.restarts}" if args.restarts is not None else ""))
 
 
 if __name__ == "__main__":

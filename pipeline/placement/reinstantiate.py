@@ -49,7 +49,7 @@ def reinstantiate(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.D
 
 def summary(rows: list[dict]) -> dict:
     placed = [r for r in rows if r["placed"]]
-    return {"rooms": len(rows), "placed": len(placed),
+    return {"rooms": len(rows), "placed": len(placed), "restarted": sum(r["attempts"] > 1 for r in rows),
             "mean_consistency_placed": round(float(np.mean([r["consistency"] for r in placed])), 4) if placed else None,
             "median_seconds": round(float(np.median([r["seconds"] for r in rows])), 2) if rows else None,
             "colliding_objects_placed": int(sum(r["colliding_objects"] for r in placed))}
