@@ -19,6 +19,23 @@ def arguments(doc: str, workdir: Path = OUT) -> argparse.ArgumentParser:
     return ap
 
 
+def search_flags(ap: argparse.ArgumentParser) -> None:
+    """``--[no-]early-backtrack`` and ``--restarts N``: the search settings a bench may set (default: the config's)."""
+    ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
+    ap.add_argument("--restarts", type=int)
+
+
+def search_overrides(args) -> dict:
+    """The ``instantiate`` keys :func:`search_flags` set on the command line."""
+    return {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts)) if v is not None}
+
+
+def search_suffix(args) -> str:
+    """The report name's suffix for the search flags given (none: the config's settings)."""
+    return ({True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
+            + (f"_restarts{args.restarts}" if args.restarts is not None else ""))
+
+
 def default_config() -> dict:
     """config/config.yaml with a single shard (benchmarks time one process)."""
     return config_mod.load(ROOT / "config" / "config.yaml", json.dumps({"shards": 1}))

@@ -10,7 +10,6 @@ extracted again: rooms placed, graph consistency, seconds per room.
 """
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import pandas as pd
@@ -20,19 +19,18 @@ from pipeline import tables
 from pipeline.placement.reinstantiate import own_plans, reinstantiate, summary
 from pipeline.stages import extract_graphs, ingest, symmetry
 
-from common import OUT, ROOT, arguments, report
+from common import OUT, ROOT, arguments, report, search_flags, search_overrides, search_suffix
 
 
 def main() -> None:
     ap = arguments(__doc__, OUT / "front3d_instantiate")
     ap.add_argument("--sample", type=Path, default=ROOT.parent / "shared" / "data" / "3d-front-meshes")
-    ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
-    ap.add_argument("--restarts", type=int)
+    search_flags(ap)
     args = ap.parse_args()
     w = args.workdir
     cfg = config_mod.validate({"source": "front3d", "shards": 1, "front3d": {
         "houses": str(args.sample / "houses"), "future": str(args.sample / "3d-future"), "cache_dir": str(w / "cache")},
-        "instantiate": {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts)) if v is not None}})
+        "instantiate": search_overrides(args)})
     ing = w / "ingest"
     outs = {t: ing / f"{t}-0.parquet" for t in ingest.OUTPUTS}
     ingest.run(cfg, 0, outs)
@@ -48,8 +46,7 @@ def main() -> None:
         print(r["room_id"], r["objects"], "placed" if r["placed"] else r["reason"], f"{r['consistency']:.3f}", f"{r['seconds']:.1f} s")
     ic = cfg["instantiate"]
     report({**summary(rows), "sample": str(args.sample), "early_backtrack": ic["early_backtrack"], "restarts": ic["restarts"]},
-           w, "front3d_instantiate" + {True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
-           + (f"_restarts{args.restarts}" if args.restarts is not None else ""))
+           w, "front3d_instantiate" + search_suffix(args))
 
 
 if __name__ == "__main__":

@@ -16,7 +16,6 @@ results/placement/<type>/cfcn/model.pt.
 """
 from __future__ import annotations
 
-import argparse
 import platform
 import statistics
 import zlib
@@ -36,7 +35,7 @@ from pipeline.placement.proposers import FaceAway
 from pipeline.placement.search import Grid, anchors_of
 from pipeline.stages import generate, instantiate, train_placement
 
-from common import ROOT, arguments, report
+from common import ROOT, arguments, report, search_flags, search_overrides, search_suffix
 
 
 def probe_networks(cfg, room_type: str, saved: dict, probes: int, checker) -> dict:
@@ -89,15 +88,12 @@ def main() -> None:
     ap.add_argument("--scenes", type=int, default=30)
     ap.add_argument("--probes", type=int, default=60)
     ap.add_argument("--no-confirm", action="store_true")
-    ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
-    ap.add_argument("--restarts", type=int)
+    search_flags(ap)
     ap.add_argument("--density-cache", type=int)
     args = ap.parse_args()
     torch.set_num_threads(1)
     cfg = config_mod.load(ROOT / "config" / "config.yaml")
-    for key in ("early_backtrack", "restarts"):
-        if getattr(args, key) is not None:
-            cfg["instantiate"][key] = getattr(args, key)
+    cfg["instantiate"].update(search_overrides(args))
     if args.density_cache:
         cfg["instantiate"]["density_cache"] = args.density_cache
     saved = torch.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", map_location="cpu", weights_only=False)
@@ -134,8 +130,7 @@ def main() -> None:
               **probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker),
               "machine": platform.processor() or platform.machine(), "threads": 1}
     report(result, args.workdir, f"instantiate_{args.room_type}" + ("_no_confirm" if args.no_confirm else "")
-           + {True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
-           + (f"_restarts{args.restarts}" if args.restarts is not None else "")
+           + search_suffix(args)
            + (f"_cache{args.density_cache}" if args.density_cache else ""))
 
 

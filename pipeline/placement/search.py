@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -356,20 +357,19 @@ def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int]
     """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed). A search that
     spends its backtrack budget starts over, up to ``cfg['restarts']`` times: attempt ``a > 0`` draws from
     ``(seed, a)``, so the first attempt is the search without restarts. Counts and seconds add up over attempts."""
-    start, total = time.perf_counter(), Outcome(False, room, attempts=0)
+    start, runs = time.perf_counter(), []
     for attempt in range(cfg["restarts"] + 1):
         s = Search(plan, room, walls, order, proposer, catalog, checker, cfg,
                    np.random.default_rng(seed if attempt == 0 else [seed, attempt]))
         reason = s.run(time.perf_counter() + cfg["time_budget"])
-        total.attempts += 1
-        total.insertions, total.rejections, total.backtracks = (total.insertions + s.insertions,
-                                                                total.rejections + s.rejections, total.backtracks + s.backtracks)
-        for kind, n in s.failures.items():
-            total.failures[kind] = total.failures.get(kind, 0) + n
+        runs.append(s)
         if not s.exhausted:
             break
-    total.ok, total.room, total.dropped = not reason, s.room, s.dropped
-    total.reason = reason or (f"dropped {len(s.dropped)} of {len(order)} objects (no place once the backtrack budget "
-                              f"was spent, no training model, or their support dropped): {', '.join(s.dropped)}" if s.dropped else "")
-    total.seconds = time.perf_counter() - start
-    return total
+    ok = not reason
+    if ok and s.dropped:
+        reason = f"dropped {len(s.dropped)} of {len(order)} objects (no place once the backtrack budget was spent, no " \
+                 f"training model, or their support dropped): {', '.join(s.dropped)}"
+    total = lambda name: sum(getattr(r, name) for r in runs)
+    failures = sum((Counter(r.failures) for r in runs), Counter())
+    return Outcome(ok, s.room, reason, time.perf_counter() - start, total("insertions"), total("rejections"),
+                   total("backtracks"), dict(failures), s.dropped, len(runs))
