@@ -104,13 +104,16 @@ def wall_footprints(w: Walls) -> np.ndarray:
     return np.stack([w.a, w.b, w.b + back, w.a + back], 1)[:, ::-1]
 
 
-def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, box_models=None) -> RoomGraph:
+def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, box_models=None,
+                 anchors: set[str] | None = None) -> RoomGraph:
     """Raw relation graph of one room.
 
     ``mesh_of(model_id) -> (vertices, faces) | None`` in model space; ``symmetry_of(category, model_id) ->
     (symmetry, origin)``; ``cfg`` is the ``extract`` config section plus the shared ``floor_contact``;
     ``intersector`` a trimesh ray class; ``box_models`` the ids of models that are only a box (the box-contact
-    rules apply to those alone; None: every model).
+    rules apply to those alone; None: every model); ``anchors``: the ids of the objects and walls whose sides are
+    swept (None: all), so that only spatial edges from them are found, each exactly as the whole sweep finds it
+    (every side is swept on its own; what is not swept only occludes).
     """
     g = RoomGraph()
     walls = merge_walls(room.wall_segments, room.wall_ids, room.wall_thickness, room.height)
@@ -153,7 +156,7 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, 
     group = np.where(tier == 1, 0, parent + 1)
     group[hanging] = n + 1 + np.flatnonzero(hanging)
     group = np.concatenate([group, np.zeros(n_walls, int)])
-    g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
+    g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg, anchors)
     _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
     return g
 
@@ -310,7 +313,7 @@ def sweep(sides: dict, all_fp: np.ndarray, group: np.ndarray) -> tuple[np.ndarra
             & (d.max(axis=2) > -sides["inset"][:, None]) & (hi > -half) & (lo < half))
     # every projected corner is a cut: within a piece each footprint's near boundary is one straight edge
     corner_cuts = np.where(live[:, :, None], np.clip(t, -half[:, :, None], half[:, :, None]), np.nan)
-    cuts = np.concatenate([-half, half, corner_cuts.reshape(len(owners), -1)], axis=1)
+    cuts = np.concatenate([-half, half, corner_cuts.reshape(len(owners), 4 * o)], axis=1)
     cuts = np.sort(cuts, axis=1)  # NaN sort last
     starts, ends = cuts[:, :-1], cuts[:, 1:]
     valid = np.isfinite(ends) & (ends - starts > 1e-6)
@@ -345,18 +348,24 @@ def touching(sides: dict, all_fp: np.ndarray, near: np.ndarray, piece_side: np.n
     return owner
 
 
-def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg) -> int:
-    """Sweep every anchor side and add the visible spatial edges. Returns the number of rays cast."""
+def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg, anchors=None) -> int:
+    """Sweep every anchor side (of ``anchors``, ids, when given) and add the visible spatial edges. Returns the
+    number of rays cast."""
     n, n_walls = len(b), len(walls.ids)
     sp = cfg["spatial"]
     sides = anchor_sides(b, walls, sp)
+    names = ids + walls.ids
+    if anchors is not None:
+        chosen = np.isin(np.asarray(names, object), list(anchors))
+        sides = {k: v[chosen[sides["owner"]]] for k, v in sides.items()}
     piece_side, starts, ends, near = sweep(sides, all_fp, group)
     diag = np.concatenate([diagonal_2d(b[:, 3], b[:, 4]), np.zeros(n_walls)])  # walls: the target's diagonal decides
     p_owner, p_dist, rays = _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n)
     touch = touching(sides, all_fp, near, piece_side, starts, ends)
     p_owner = np.where(touch >= 0, touch, p_owner)
     ok = (p_owner >= 0) & (p_owner < n)  # pieces that reach an object (walls only occlude)
-    contained = _contained_pairs(all_fp[:n], group[:n], sp["contain_fraction"])
+    contained = {(a, t) for a, t in _contained_pairs(all_fp[:n], group[:n], sp["contain_fraction"])
+                 if anchors is None or names[a] in anchors}
     if not ok.any() and not contained:
         return rays
     total = n + n_walls
@@ -378,7 +387,6 @@ def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg)
     u_anchor, u_sidx = sides["owner"][u_side], sides["side"][u_side]
     seen = {"anchor": u_anchor, "target": u_target, "side": u_sidx, "gap": gap, "target_share": target_share,
             "anchor_share": anchor_share, "score": np.maximum(target_share, anchor_share)}
-    names = ids + walls.ids
     _emit_spatial_edges(g, room_id, seen, contained, names, n, diag, radial, cfg)
     return rays
 

@@ -368,3 +368,63 @@ def test_the_filter_and_extraction_share_one_floor_contact_tolerance():
     lifted = r.extract(cfg={**cfg, "floor_contact": 0.005}, box_models=set())  # stricter: the sofa now casts rays
     # ... which start inside the table's box and meet only its downward-facing bottom: no parent either way
     assert {n["node_id"]: (n["tier"], n["parent_id"]) for n in lifted.nodes}["sofa"] == (1, None)
+
+
+def _focused_matches_whole(room_input, mesh_of, rng, cfg=None, cases=4) -> int:
+    """Extract ``room_input`` whole and with a few random anchor sets; every focused graph must hold exactly the
+    whole graph's nodes, support and architecture edges, and its spatial edges from the chosen anchors. Returns the
+    number of spatial edges compared."""
+    from pipeline.extraction import extract_room
+    from pipeline.geometry.raycast import intersector_class
+
+    defaults = default_config()
+    cfg = cfg or {"floor_contact": defaults["floor_contact"], **defaults["extract"]}
+    args = (room_input, mesh_of, lambda c, m: ("none", "table"), cfg, intersector_class("embree"))
+    whole = extract_room(*args)
+    names = sorted({n["node_id"] for n in whole.nodes})
+    compared = 0
+    for k in range(cases):
+        chosen = set(rng.choice(names, size=min(len(names), k), replace=False).tolist())
+        part = extract_room(*args, anchors=chosen)
+        want = [e for e in whole.edges if e["edge_type"] != "spatial" or e["source"] in chosen]
+        assert part.nodes == whole.nodes and part.edges == want, (room_input.room_id, chosen)
+        compared += sum(e["edge_type"] == "spatial" for e in want)
+    return compared
+
+
+def test_sweeping_some_anchors_finds_exactly_their_edges_of_the_whole_sweep():
+    """What instantiation's relation check asks for (only the new object's planned anchors are swept, everything
+    else still occludes): flush, overlapping, turned, on top of each other, in an L-shaped room."""
+    rng = np.random.default_rng(0)
+    l_room = Room([[0, 0], [6, 0], [6, 3], [3, 3], [3, 5], [0, 5]])
+    l_room.add("sofa", "sofa", (2.0, 2.0, 0.8), (1.5, 1.5), mesh=l_sofa_mesh())
+    l_room.add("coffee", "coffee_table", (0.8, 0.5, 0.4), (1.8, 1.8), yaw_deg=33.0)  # inside the L sofa's box
+    l_room.add("table", "table", (1.2, 0.8, 0.75), (4.5, 1.5), mesh=table_mesh(1.2, 0.8, 0.75))
+    l_room.add("chair", "chair", (0.5, 0.5, 0.9), (4.5, 1.05), yaw_deg=181.0)  # tucked under the table
+    l_room.add("lamp", "floor_lamp", (0.4, 0.4, 1.6), (2.9, 2.8), yaw_deg=77.0)  # at the reflex corner
+    l_room.add("vase", "vase", (0.2, 0.2, 0.3), (4.5, 1.5), z=0.75)  # on the table
+    rooms = [bedroom(), l_room]
+    row = square_room(3.956)
+    for k, (x, y) in enumerate(ROW_180[:3]):
+        row.add(f"w{k}", "wardrobe", (0.992978, 0.60236, 2.0), (x, y), yaw_deg=180.0)
+    rooms.append(row)
+    compared = sum(_focused_matches_whole(r.room_input(), r.models.get, rng) for r in rooms)
+    assert compared >= 10
+
+
+def test_sweeping_some_anchors_on_real_3d_front_rooms(tmp_path):
+    """The same on the 3D-FRONT sample's rooms, real 3D-FUTURE meshes."""
+    from conftest import shared_data
+    from pipeline import tables
+    from pipeline.roomdata import room_inputs
+    from test_sources import run_ingest
+
+    sample = shared_data("3d-front-meshes")
+    t = run_ingest("front3d", {"houses": str(sample / "houses"), "future": str(sample / "3d-future"),
+                               "cache_dir": str(tmp_path / "cache")}, tmp_path)
+    tables.write(tmp_path / "models.parquet", "models", tables.pa.Table.from_pandas(t["models"], preserve_index=False))
+    mesh_of, _ = tables.read_meshes(tmp_path / "models.parquet", t["objects"].model_id.dropna())
+    rng = np.random.default_rng(1)
+    inputs = list(room_inputs(t["rooms"], t["architecture"], t["objects"]))
+    compared = sum(_focused_matches_whole(r, mesh_of.get, rng, cases=3) for r in inputs)
+    assert len(inputs) >= 10 and compared >= 30

@@ -402,3 +402,29 @@ def test_early_backtrack_still_places_the_hand_built_bedroom_with_every_planned_
                       catalog, checker, ic, 0)
     assert out.ok, out.reason
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
+
+
+def test_the_free_floor_kept_between_samples_follows_every_insertion_and_backtrack():
+    """free_floor keeps its last answer while the room stays the same (an object's samples ask again): an inserted
+    floor object takes its cells, a backtrack gives them back, a turned one takes its turned footprint, and a
+    caller masking its copy changes nothing."""
+    from pipeline.placement.search import Search
+
+    l_room = ((0, 0), (4, 0), (4, 2), (2, 2), (2, 4), (0, 4))
+    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"], outline=l_room)
+    plan = bedroom_plan()
+    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()), catalog,
+               checker, ic, np.random.default_rng(0))
+    half = np.array([0.25, 0.2])
+    empty = s.free_floor(half)
+    empty[:] = False  # the caller's copy
+    assert np.array_equal(s.free_floor(half), s.grid.floor) and s.grid.floor.sum() > 1000
+    pts = s.grid.points
+    for yaw in (0.0, 0.61):
+        s.room = add_object(room, "bed", "bed", "m_bed_0", np.array([1.0, 1.0, 0.25, 0.8, 1.0, 0.25, yaw]),
+                            np.array([1.0, 1.0, 0.0, yaw, 1.0, 1.0, 1.0]))
+        local = to_local(Frame((1.0, 1.0), yaw), pts)
+        covered = (np.abs(local[:, 0]) <= 0.8 + 0.2) & (np.abs(local[:, 1]) <= 1.0 + 0.2)
+        assert np.array_equal(s.free_floor(half), s.grid.floor & ~covered)
+    s.room = with_objects(s.room, [])  # backtracked
+    assert np.array_equal(s.free_floor(half), s.grid.floor)

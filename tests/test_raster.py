@@ -63,3 +63,31 @@ def test_a_room_larger_than_the_window_is_cropped_to_it():
     corner = raster.render_room(big, polygon_segments(big), np.full(4, 0.1), {}, np.zeros((0, 7)), np.zeros(0, int), 1,
                                 64, 0.1, (0.0, 0.0))
     assert corner[0].mean() == pytest.approx(0.25, abs=0.02) and corner[1].any()
+
+
+def test_small_and_large_windows_fill_the_same_pixels_in_one_call_as_one_by_one():
+    """Windows under raster.FLAT_WINDOW pixels are tested as one flat array, larger ones one by one: a mix in one
+    call, turned at odd angles and overlapping, fills exactly what each quad fills alone and what shapely holds."""
+    rng = np.random.default_rng(3)
+    half = np.concatenate([rng.uniform(0.05, 0.3, (12, 2)), [[2.5, 1.9], [0.02, 2.8]]])  # two windows > 1024 px
+    corners = footprint_corners(rng.uniform(-2, 2, 14), rng.uniform(-2, 2, 14), half[:, 0], half[:, 1],
+                                rng.uniform(-np.pi, np.pi, 14))
+    together = np.zeros((64, 64))
+    raster.fill_quads(together, corners, 1.0, 0.1, (0.0, 0.0))
+    alone = np.zeros((64, 64))
+    for c in corners:
+        raster.fill_quads(alone, c[None], 1.0, 0.1, (0.0, 0.0))
+    assert np.array_equal(together, alone) and together.sum() > 1500
+    inside, dist = centres_inside(shapely.union_all(shapely.polygons(corners)), 64, 0.1, (0.0, 0.0))
+    assert ((together > 0) == inside)[dist > 1e-6].all()
+
+
+def test_a_wall_without_thickness_fills_its_own_length_only():
+    """A slab of zero width is a segment: its pixels lie on it (within a pixel of its ends), never on the line
+    beyond (where every edge test of the flat quad holds)."""
+    seg = np.array([[[-1.0, 0.05], [1.0, 0.05]]])  # along a row of pixel centres
+    image = np.zeros((64, 64))
+    raster.fill_quads(image, raster.segment_quads(seg, np.zeros(1)), 1.0, 0.1, (0.0, 0.0))
+    rows, cols = np.nonzero(image)
+    xs, _ = raster.pixel_centres(64, 0.1, (0.0, 0.0))
+    assert set(rows) == {31} and 20 <= len(cols) <= 22 and (np.abs(xs[cols]) <= 1.0 + 0.1).all()

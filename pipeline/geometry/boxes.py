@@ -15,7 +15,9 @@ SIDE_NORMALS = np.array([[0.0, 1.0], [0.0, -1.0], [-1.0, 0.0], [1.0, 0.0]])
 def rotation(yaw) -> np.ndarray:
     """``(..., 2, 2)`` rotation matrices local -> world."""
     c, s = np.cos(yaw), np.sin(yaw)
-    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+    out = np.empty(np.shape(c) + (2, 2), np.result_type(c))
+    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
+    return out
 
 
 def footprint_corners(cx, cy, hx, hy, yaw) -> np.ndarray:

@@ -32,29 +32,46 @@ def fill_polygon(xy: np.ndarray, size: int, mpp: float, centre) -> np.ndarray:
     return left_of % 2 == 1
 
 
-def quad_masks(corners: np.ndarray, size: int, mpp: float, centre):
-    """For each convex quad ``corners (n, 4, 2)`` (counter-clockwise): its pixel window ``(rows, cols)`` as slices
-    and the bool mask of pixel centres inside it within that window (None for a quad outside the view)."""
+FLAT_WINDOW = 1024  # pixels: smaller windows are tested all at once as one flat array, larger ones one by one
+
+
+def _left_of_edges(corners: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    """Whether points ``(px, py)`` lie left of (or on) all 4 edges of ``corners (..., 4, 2)``, broadcast together."""
+    inside = np.ones(np.broadcast_shapes(corners.shape[:-2], px.shape, py.shape), bool)
+    for e in range(4):
+        x0, y0, x1, y1 = corners[..., e, 0], corners[..., e, 1], corners[..., (e + 1) % 4, 0], corners[..., (e + 1) % 4, 1]
+        inside &= (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0) >= 0
+    return inside
+
+
+def quad_pixels(corners: np.ndarray, size: int, mpp: float, centre) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pixels whose centres lie inside each convex quad ``corners (n, 4, 2)`` (counter-clockwise), as
+    ``(quad, row, col)`` index arrays ``(k,)``. Each quad is tested only within its own bounding window of pixels
+    (one pixel wider): windows under :data:`FLAT_WINDOW` pixels all at once, larger ones one by one."""
+    corners = np.asarray(corners, float).reshape(-1, 4, 2)
     xs, ys = pixel_centres(size, mpp, centre)
     col = np.clip(((corners[..., 0] - xs[0]) / mpp + 0.5).astype(int), 0, size)  # bounding windows in pixels
     row = np.clip(((ys[0] - corners[..., 1]) / mpp + 0.5).astype(int), 0, size)
-    for q, c0, c1, r0, r1 in zip(corners, col.min(1) - 1, col.max(1) + 1, row.min(1) - 1, row.max(1) + 1):
-        c0, r0, c1, r1 = max(c0, 0), max(r0, 0), min(c1, size), min(r1, size)
-        if c1 <= c0 or r1 <= r0:
-            yield None
-            continue
-        px, py = xs[None, c0:c1], ys[r0:r1, None]
-        inside = np.ones((r1 - r0, c1 - c0), bool)
-        for (x0, y0), (x1, y1) in zip(q, np.roll(q, -1, axis=0)):  # left of every edge
-            inside &= (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0) >= 0
-        yield (slice(r0, r1), slice(c0, c1)), inside
+    c0, r0 = np.maximum(col.min(1) - 1, 0), np.maximum(row.min(1) - 1, 0)
+    width = np.maximum(np.minimum(col.max(1) + 1, size) - c0, 0)
+    height = np.maximum(np.minimum(row.max(1) + 1, size) - r0, 0)
+    area = np.where(width * height <= FLAT_WINDOW, width * height, 0)
+    q = np.repeat(np.arange(len(corners)), area)  # one entry per pixel of every small window
+    local = np.arange(len(q)) - np.repeat(np.cumsum(area) - area, area)
+    rows, cols = r0[q] + local // np.maximum(width[q], 1), c0[q] + local % np.maximum(width[q], 1)
+    inside = _left_of_edges(corners[q], xs[cols], ys[rows])
+    out = [(q[inside], rows[inside], cols[inside])]
+    for k in np.flatnonzero(width * height > FLAT_WINDOW):
+        r, c = np.arange(r0[k], r0[k] + height[k]), np.arange(c0[k], c0[k] + width[k])
+        i, j = np.nonzero(_left_of_edges(corners[k], xs[None, c], ys[r, None]))
+        out.append((np.full(len(i), k), r[i], c[j]))
+    return tuple(np.concatenate(parts) for parts in zip(*out))
 
 
 def fill_quads(image: np.ndarray, corners: np.ndarray, value: float, mpp: float, centre) -> None:
     """Set ``value`` in ``image (size, size)`` inside each convex quad ``corners (n, 4, 2)``."""
-    for hit in quad_masks(corners, image.shape[0], mpp, centre):
-        if hit is not None:
-            image[hit[0]][hit[1]] = value
+    _, rows, cols = quad_pixels(corners, image.shape[0], mpp, centre)
+    image[rows, cols] = value
 
 
 def segment_quads(segments: np.ndarray, half_width) -> np.ndarray:
@@ -84,23 +101,40 @@ def render_room(outline: np.ndarray, walls: np.ndarray, wall_half: np.ndarray, o
 
     image = np.zeros((len(CHANNELS) + n_categories, size, size), np.float32)
     image[0] = fill_polygon(outline, size, mpp, centre)
-    fill_quads(image[1], segment_quads(walls, wall_half), 1.0, mpp, centre)
-    for k, name in ((2, "doors"), (3, "windows")):
-        seg = np.asarray(openings.get(name, np.zeros((0, 2, 2))), float).reshape(-1, 2, 2)
-        fill_quads(image[k], segment_quads(seg, np.full(len(seg), 2 * mpp)), 1.0, mpp, centre)
+    seg = [np.asarray(openings.get(name, np.zeros((0, 2, 2))), float).reshape(-1, 2, 2) for name in ("doors", "windows")]
+    slabs = [segment_quads(walls, wall_half), *(segment_quads(s, np.full(len(s), 2 * mpp)) for s in seg)]
+    channel = np.repeat([1, 2, 3], [len(s) for s in slabs])  # walls, doors, windows
     b = np.asarray(boxes, float).reshape(-1, 7)
-    if not len(b):
-        return image
+    order = np.argsort(b[:, 2] + b[:, 5], kind="stable")  # low to high: the higher object wins
+    footprints = footprint_corners(b[order, 0], b[order, 1], b[order, 3], b[order, 4], b[order, 6]).reshape(-1, 4, 2)
+    q, rows, cols = quad_pixels(np.concatenate([*slabs, footprints]), size, mpp, centre)
+    arch = q < len(channel)
+    image[channel[q[arch]], rows[arch], cols[arch]] = 1.0
+    q, rows, cols = q[~arch] - len(channel), rows[~arch], cols[~arch]  # objects, by rank in ``order``
+    k = order[q]
+    image[len(CHANNELS) + np.asarray(category, int)[k], rows, cols] = 1.0
+    if anchor is not None:
+        mine = k == anchor
+        image[7, rows[mine], cols[mine]] = 1.0
+    top = np.full((size, size), -1)
+    np.maximum.at(top, (rows, cols), q)  # per pixel, the highest object covering it
+    rows, cols = np.nonzero(top >= 0)
+    k = order[top[rows, cols]]
+    for c, values in zip((4, 5, 6), (b[:, 2] + b[:, 5], np.sin(b[:, 6]), np.cos(b[:, 6]))):
+        image[c, rows, cols] = values[k]
+    return image
     quads = footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
     order = np.argsort(b[:, 2] + b[:, 5], kind="stable")  # low to high: the higher object wins
-    for k, hit in zip(order, quad_masks(quads[order], size, mpp, centre)):
-        if hit is None:
-            continue
-        (rows, cols), inside = hit
-        values = (b[k, 2] + b[k, 5], np.sin(b[k, 6]), np.cos(b[k, 6]))
-        for channel, v in zip((4, 5, 6), values):
-            image[channel, rows, cols][inside] = v
-        image[len(CHANNELS) + int(category[k]), rows, cols][inside] = 1.0
-        if anchor == k:
-            image[7, rows, cols][inside] = 1.0
+    q, rows, cols = quad_pixels(quads[order], size, mpp, centre)
+    k = order[q]
+    image[len(CHANNELS) + np.asarray(category, int)[k], rows, cols] = 1.0
+    if anchor is not None:
+        mine = k == anchor
+        image[7, rows[mine], cols[mine]] = 1.0
+    top = np.full((size, size), -1)
+    np.maximum.at(top, (rows, cols), q)  # per pixel, the highest object covering it
+    rows, cols = np.nonzero(top >= 0)
+    k = order[top[rows, cols]]
+    for c, values in zip((4, 5, 6), (b[:, 2] + b[:, 5], np.sin(b[:, 6]), np.cos(b[:, 6]))):
+        image[c, rows, cols] = values[k]
     return image

@@ -48,9 +48,10 @@ class Checker:
         """Each object's ``(vertices, faces)``, or None where it is measured as its box."""
         return [None if m in self.box_models else self.meshes.get(m) for m in room.model_ids]
 
-    def extract(self, room: RoomInput):
+    def extract(self, room: RoomInput, anchors: set[str] | None = None):
+        """The room's relation graph; with ``anchors`` (ids), only the spatial edges from them."""
         return extract_room(room, self.meshes.get, lambda c, m: (self.symmetry.get(m, "none"), "table"),
-                            self.extract_cfg, self.intersector, self.box_models)
+                            self.extract_cfg, self.intersector, self.box_models, anchors)
 
 
 def support_share(child: np.ndarray, parent: np.ndarray) -> float:
@@ -108,7 +109,7 @@ def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) ->
     extracted graph, and the objects at the other end of the edges not found exactly."""
     if not planned:
         return 0.0, set()
-    found = found_edges(checker.extract(room).edges)
+    found = found_edges(checker.extract(room, anchors={e.source for e in planned}).edges)
     costs = [edge_cost(e, found) for e in planned]
     objects = set(room.object_ids)
     blame = {n for e, c in zip(planned, costs) if c > 0 for n in (e.source, e.target) if n in objects}

@@ -192,6 +192,7 @@ class Search:
         self.failures: dict[str, int] = {}
         self.dropped: list[str] = []
         self.exhausted = False  # the backtrack budget ran out (the one failure a restart may cure)
+        self._free = None  # the last free_floor: (room boxes and grow, cells)
 
     def model_for(self, k: int):
         """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's."""
@@ -208,18 +209,20 @@ class Search:
 
     def occupied(self, grow: float) -> np.ndarray:
         """``(cells,)`` candidate centres inside a placed floor object's footprint grown by ``grow`` m."""
-        out = np.zeros(len(self.grid.points), bool)
-        b = self.room.boxes
-        for j in np.flatnonzero(b[:, 2] - b[:, 5] < self.cfg["checks"]["collision"] + 0.05):
-            g = b[j].copy()
-            g[3:5] += grow
-            out |= _in_box(self.grid.points, g)
-        return out
+        b = self.room.boxes.reshape(-1, 7)
+        b = b[b[:, 2] - b[:, 5] < self.cfg["checks"]["collision"] + 0.05]
+        local = (self.grid.points[None] - b[:, None, :2]) @ rotation(b[:, 6])  # (floor objects, cells, 2)
+        half = np.maximum(b[:, 3:5] + grow, 0.0)[:, None, :]
+        inside = np.abs(local) <= half
+        return (inside[..., 0] & inside[..., 1]).any(0)
 
     def free_floor(self, half) -> np.ndarray:
         """``(cells,)`` candidate centres on the floor and off the placed floor objects grown by the smaller of an
-        object's half extents ``half (2,)``."""
-        return self.grid.floor & ~self.occupied(min(half))
+        object's half extents ``half (2,)`` (a fresh array; the last one is kept, as an object's samples ask again)."""
+        key = (self.room.boxes.tobytes(), float(min(half)))
+        if self._free is None or self._free[0] != key:
+            self._free = (key, self.grid.floor & ~self.occupied(min(half)))
+        return self._free[1].copy()
 
     def band_cells(self, anchors: list[Anchor], half) -> np.ndarray:
         """``(cells,)`` :meth:`free_floor` cells inside every anchor's planned band
