@@ -123,18 +123,3 @@ def render_room(outline: np.ndarray, walls: np.ndarray, wall_half: np.ndarray, o
     for c, values in zip((4, 5, 6), (b[:, 2] + b[:, 5], np.sin(b[:, 6]), np.cos(b[:, 6]))):
         image[c, rows, cols] = values[k]
     return image
-    quads = footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
-    order = np.argsort(b[:, 2] + b[:, 5], kind="stable")  # low to high: the higher object wins
-    q, rows, cols = quad_pixels(quads[order], size, mpp, centre)
-    k = order[q]
-    image[len(CHANNELS) + np.asarray(category, int)[k], rows, cols] = 1.0
-    if anchor is not None:
-        mine = k == anchor
-        image[7, rows[mine], cols[mine]] = 1.0
-    top = np.full((size, size), -1)
-    np.maximum.at(top, (rows, cols), q)  # per pixel, the highest object covering it
-    rows, cols = np.nonzero(top >= 0)
-    k = order[top[rows, cols]]
-    for c, values in zip((4, 5, 6), (b[:, 2] + b[:, 5], np.sin(b[:, 6]), np.cos(b[:, 6]))):
-        image[c, rows, cols] = values[k]
-    return image
