@@ -1,5 +1,5 @@
 # Two entry points for a fresh machine (see README):
-#   make pipeline   set up .venv and run the whole pipeline on the built-in procedural corpus
+#   make pipeline   set up .venv, run the whole pipeline on the built-in procedural corpus, write its report
 #   make test       set up .venv and run the test suite (what .ci/run calls)
 PYTHON ?= python3
 VENV ?= .venv
@@ -17,6 +17,7 @@ $(VENV)/.installed: pyproject.toml
 
 pipeline: setup
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/snakemake --cores $(CORES)
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/snakemake --report results/report.html
 
 # The report's browser test needs Debian's chromium and chromium-driver: installed here when missing and this is a
 # Debian machine run as root; elsewhere that one test skips and says why.

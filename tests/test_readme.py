@@ -42,6 +42,8 @@ def test_readme_commands_work_as_written(clone):
                              timeout=600)
         assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}"
         ran += 1
+        if cmd == "make pipeline":  # it ends with the report
+            assert (clone / "results/report.html").stat().st_size > 100_000, out.stdout[-2000:]
         if " -d " in cmd:  # a run in a work folder of its own: it produced the graphs there
             work = clone / cmd.split(" -d ")[1].split()[0]
             assert (work / "results/graphs/ingested/edges.parquet").exists(), cmd
