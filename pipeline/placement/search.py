@@ -166,10 +166,13 @@ def tolerance(backtracks: int, budget: int) -> float:
 
 
 def _in_box(points: np.ndarray, b: np.ndarray, inset=(0.0, 0.0), least: float = 0.0) -> np.ndarray:
-    """``(m,)`` points inside box ``b``'s footprint shrunk by ``inset`` (x, y) m in its frame, each half extent kept
-    >= ``least`` m."""
-    local = (points - b[:2]) @ rotation(b[6])
-    return ((np.abs(local[:, 0]) <= max(b[3] - inset[0], least)) & (np.abs(local[:, 1]) <= max(b[4] - inset[1], least)))
+    """``(m,)`` points inside box ``b (7,)``'s footprint shrunk by ``inset`` (x, y) m in its frame, each half extent
+    kept >= ``least`` m; for boxes ``b (k, 7)``, ``(k, m)``."""
+    boxes = np.asarray(b, float).reshape(-1, 7)
+    local = (points[None] - boxes[:, None, :2]) @ rotation(boxes[:, 6])  # (k, m, 2)
+    inside = np.abs(local) <= np.maximum(boxes[:, 3:5] - np.asarray(inset, float), least)[:, None, :]
+    out = inside[..., 0] & inside[..., 1]
+    return out if np.ndim(b) == 2 else out[0]
 
 
 class Search:
@@ -210,18 +213,16 @@ class Search:
     def occupied(self, grow: float) -> np.ndarray:
         """``(cells,)`` candidate centres inside a placed floor object's footprint grown by ``grow`` m."""
         b = self.room.boxes.reshape(-1, 7)
-        b = b[b[:, 2] - b[:, 5] < self.cfg["checks"]["collision"] + 0.05]
-        local = (self.grid.points[None] - b[:, None, :2]) @ rotation(b[:, 6])  # (floor objects, cells, 2)
-        half = np.maximum(b[:, 3:5] + grow, 0.0)[:, None, :]
-        inside = np.abs(local) <= half
-        return (inside[..., 0] & inside[..., 1]).any(0)
+        floor = b[b[:, 2] - b[:, 5] < self.cfg["checks"]["collision"] + 0.05]
+        return _in_box(self.grid.points, floor, (-grow, -grow)).any(0)
 
     def free_floor(self, half) -> np.ndarray:
         """``(cells,)`` candidate centres on the floor and off the placed floor objects grown by the smaller of an
         object's half extents ``half (2,)`` (a fresh array; the last one is kept, as an object's samples ask again)."""
-        key = (self.room.boxes.tobytes(), float(min(half)))
+        grow = float(min(half))
+        key = (self.room.boxes.tobytes(), grow)
         if self._free is None or self._free[0] != key:
-            self._free = (key, self.grid.floor & ~self.occupied(min(half)))
+            self._free = (key, self.grid.floor & ~self.occupied(grow))
         return self._free[1].copy()
 
     def band_cells(self, anchors: list[Anchor], half) -> np.ndarray:
