@@ -14,7 +14,7 @@ from pathlib import Path
 
 from pipeline.extraction import extract_room
 from pipeline.geometry.raycast import intersector_class
-from pipeline.roomdata import room_inputs
+from pipeline.room import room_inputs
 from pipeline.stages import symmetry
 from pipeline.stages.extract_graphs import load_shard
 

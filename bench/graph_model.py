@@ -18,8 +18,11 @@ import numpy as np
 import torch
 
 from pipeline import config as config_mod
-from pipeline.learn import graph_checks, graph_data, sampler, train
-from pipeline.learn.teacher import make_batch, nll
+from pipeline.graphs import checks as graph_checks
+from pipeline.graphs import data as graph_data
+from pipeline.methods.planit.graph_model import sampler
+from pipeline.methods.planit.graph_model import train
+from pipeline.methods.planit.graph_model.teacher import make_batch, nll
 from pipeline.stages.train_graph_model import room_graphs
 
 from common import ROOT, arguments, report

@@ -25,9 +25,10 @@ import torch
 
 from pipeline import config as config_mod
 from pipeline.evaluation import physical
+from pipeline.learning import checkpoint
 from pipeline.geometry.frames import yaw_to_local
-from pipeline.learn.placement_data import bin_targets, orientation_frame
-from pipeline.learn.placement_proposer import NetProposer
+from pipeline.methods.planit.nets.data import bin_targets, orientation_frame
+from pipeline.methods.planit.nets.proposer import NetProposer
 from pipeline.placement.layout import render, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement import scene_metrics
@@ -96,7 +97,7 @@ def main() -> None:
     cfg["instantiate"].update(search_overrides(args))
     if args.density_cache:
         cfg["instantiate"]["density_cache"] = args.density_cache
-    saved = torch.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", map_location="cpu", weights_only=False)
+    saved = checkpoint.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", "placement_nets")
     p = generate.corpus_paths(cfg)
     ctx = instantiate.load_context(cfg, args.room_type, saved, p["rooms"], p["architecture"], p["objects"], p["models"],
                                    p["symmetry"], p["category_sizes"])

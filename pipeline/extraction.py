@@ -16,35 +16,16 @@ import shapely
 
 from .geometry import meshes, relations
 from .geometry.boxes import SIDE_NORMALS, SIDES, diagonal_2d, rotation
-from .geometry.polygon import inward_normals, merge_collinear, outline_from_loop, segment_distances, signed_area, wall_loop
+from .geometry.polygon import segment_distances
 from .geometry.raycast import RoomScene
+from .room import BOX_COLUMNS, RoomInput, Walls, merge_walls, wall_footprints
 
 log = logging.getLogger("planit.extract")
 
 PLAN_Z = (-3.0, -2.0)  # z band of the plan layer (below any floor-standing geometry)
 MESH, PLAN = 0, 1  # scene layers
-BOX_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
-POSE_COLUMNS = ["px", "py", "pz", "yaw", "sx", "sy", "sz"]
 PIECE_INSET = 1e-3  # m, rays start this far in from each piece's ends
 TOUCH = 1e-6  # m, a footprint this close to an anchor side (or reaching behind it) touches it
-
-
-@dataclass
-class RoomInput:
-    """One room as arrays: what extraction needs from the canonical tables."""
-    room_id: str
-    room_type: str
-    height: float
-    outline: np.ndarray  # (k, 2) floor outline
-    wall_ids: list[str]
-    wall_segments: np.ndarray  # (w, 2, 2) inner faces
-    wall_thickness: np.ndarray  # (w,)
-    openings: list[dict]  # element_id, kind, x0, y0, x1, y1, z0, z1
-    object_ids: list[str]
-    categories: list[str]
-    model_ids: list[str]
-    boxes: np.ndarray  # (n, 7) BOX_COLUMNS
-    poses: np.ndarray  # (n, 7) POSE_COLUMNS
 
 
 @dataclass
@@ -55,53 +36,6 @@ class RoomGraph:
     rays: int = 0
     support_cycles: int = 0
     hanging: int = 0  # objects with nothing below and a bottom high above the floor
-
-
-@dataclass
-class Walls:
-    """Merged wall segments of a room in loop order (inner faces, counter-clockwise)."""
-    ids: list[str]
-    a: np.ndarray  # (w, 2) start points
-    b: np.ndarray  # (w, 2) end points
-    normal: np.ndarray  # (w, 2) into the room
-    thickness: np.ndarray
-    height: float
-
-    @property
-    def length(self) -> np.ndarray:
-        return np.linalg.norm(self.b - self.a, axis=1)
-
-    @property
-    def dir(self) -> np.ndarray:
-        return (self.b - self.a) / self.length[:, None]
-
-
-def merge_walls(segs: np.ndarray, ids: list[str], thick: np.ndarray, height: float, tol: float = 1e-3) -> Walls:
-    """Order wall segments along their loop, make it counter-clockwise and merge collinear neighbours.
-
-    A merged wall keeps the id of the original wall at its start. Raises ValueError for an open loop.
-    """
-    segs = np.asarray(segs, float).reshape(-1, 2, 2)
-    thick = np.where(np.isfinite(thick), thick, 0.1)
-    closed, why, order = wall_loop(segs, tol)
-    if not closed:
-        raise ValueError(f"walls do not form a closed loop: {why}")
-    oriented = [(segs[o], o) if o >= 0 else (segs[-o - 1][::-1], -o - 1) for o in order]
-    if signed_area(outline_from_loop(segs, order)) < 0:
-        oriented = [(s[::-1], k) for s, k in oriented[::-1]]
-    start = {tuple(np.round(s[0], 6)): k for s, k in oriented}
-    outline = merge_collinear(np.array([s[0] for s, _ in oriented]))
-    keys = [start.get(tuple(np.round(p, 6))) for p in outline]
-    names = [ids[k] if k is not None else f"wall_m{i}" for i, k in enumerate(keys)]
-    thickness = np.array([thick[k] if k is not None else float(np.median(thick)) for k in keys])
-    nxt = np.roll(outline, -1, axis=0)
-    return Walls(names, outline, nxt, inward_normals(np.stack([outline, nxt], 1)), thickness, height)
-
-
-def wall_footprints(w: Walls) -> np.ndarray:
-    """(w, 4, 2) counter-clockwise footprints of the walls, behind their inner faces."""
-    back = -w.normal * w.thickness[:, None]
-    return np.stack([w.a, w.b, w.b + back, w.a + back], 1)[:, ::-1]
 
 
 def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, box_models=None,

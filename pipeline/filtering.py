@@ -5,16 +5,13 @@ report row names the first rule that rejected it and lists every rule it fails.
 """
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import numpy as np
 import pandas as pd
 
 from .geometry import boxes
-from .geometry.collision import mesh_penetration
-from .geometry.meshes import transform
+from .geometry.collision import deepest_penetration
 from .geometry.polygon import poke_out, wall_loop
-from .roomdata import room_slices
+from .room import room_slices
 
 RULES = ("unknown_room_type", "wall_loop", "room_height", "room_size", "too_few_objects", "too_many_objects",
          "mislabeled", "rare_category", "outside_room", "interpenetration")
@@ -81,46 +78,6 @@ def _placement_reasons(room, objs: dict, cfg: dict) -> list[tuple[str, str]]:
         i, j, d, measure = worst
         out.append(("interpenetration", f"{ids[i]} and {ids[j]} interpenetrate by {d:.2f} m ({measure})"))
     return out
-
-
-def penetrating_pairs(box_depth: np.ndarray, objs: dict, cfg: dict) -> Iterator[tuple[int, int, float, str]]:
-    """Pairs ``(i, j, depth, measure)``, deepest box overlap first, that penetrate deeper than ``max_penetration``:
-    measured on the meshes where both objects have one (``penetration.measure: mesh``), else on the boxes.
-
-    ``cfg['confirm']`` (optional, a finer ``penetration``): a mesh pair the first grid clears is measured again on
-    this one, so a coarse grid may screen but never clear a pair that the finer measure finds penetrating (the
-    depth is accurate to one pitch only)."""
-    pen, limit = cfg["penetration"], cfg["max_penetration"]
-    i, j = np.nonzero(np.triu(box_depth > limit, 1))
-    for k in np.argsort(-box_depth[i, j], kind="stable"):
-        a, b = int(i[k]), int(j[k])
-        ma, mb = objs["meshes"][a], objs["meshes"][b]
-        if pen["measure"] == "box" or ma is None or mb is None:
-            yield a, b, float(box_depth[a, b]), "boxes"
-            continue
-        d = _mesh_depth(_world(ma, objs["poses"][a]), _world(mb, objs["poses"][b]), float(box_depth[a, b]), cfg)
-        if d > limit:
-            yield a, b, d, "meshes"
-
-
-def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], box_depth: float, cfg: dict) -> float:
-    """Two world meshes' penetration on ``cfg['penetration']``'s grid, measured again on ``cfg['confirm']``'s where
-    the first finds at most ``max_penetration`` (``confirm.measure: box`` takes the boxes' depth instead)."""
-    d = mesh_penetration(a, b, cfg["intersector"], cfg["penetration"])
-    confirm = cfg.get("confirm")
-    if confirm is None or d > cfg["max_penetration"]:
-        return d
-    return box_depth if confirm["measure"] == "box" else mesh_penetration(a, b, cfg["intersector"], confirm)
-
-
-def deepest_penetration(box_depth: np.ndarray, objs: dict, cfg: dict) -> tuple[int, int, float, str] | None:
-    """The first of :func:`penetrating_pairs` (None if no pair penetrates)."""
-    return next(penetrating_pairs(box_depth, objs, cfg), None)
-
-
-def _world(mesh: tuple[np.ndarray, np.ndarray], pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A model's ``(vertices, faces)`` placed by a pose row ``(px, py, pz, yaw, sx, sy, sz)``."""
-    return transform(mesh[0], pose[:3], pose[3], pose[4:]), mesh[1]
 
 
 def filter_rooms(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.DataFrame, cfg: dict,

@@ -16,7 +16,7 @@ from pipeline.extraction import extract_room
 from pipeline.geometry import meshes
 from pipeline.geometry.polygon import polygon_segments
 from pipeline.geometry.raycast import intersector_class
-from pipeline.roomdata import room_inputs
+from pipeline.room import room_inputs
 
 ROOT = Path(__file__).resolve().parents[1]
 # Real sample data (never copied into the repository): PLANIT_SHARED_DATA, by default ../shared/data beside the clone.

@@ -84,7 +84,7 @@ def test_real_furniture_meshes_overlap_far_less_than_their_boxes(tmp_path):
     """The 3D-FRONT sample with real 3D-FUTURE meshes: every pair whose boxes overlap by more than the filter's
     0.15 m is measured on the meshes; chairs tucked under tables overlap 0.4 m as boxes and about 3 cm as meshes."""
     from pipeline import tables
-    from pipeline.filtering import _world
+    from pipeline.geometry.collision import world_mesh as _world
     from pipeline.geometry import boxes
     from test_sources import run_ingest
 

@@ -10,9 +10,9 @@ from pathlib import Path
 import pandas as pd
 import pyarrow.parquet as pq
 import pytest
-import torch
 
 from pipeline import tables
+from pipeline.learning import checkpoint
 from conftest import ROOT
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("e2e_run")]
@@ -176,7 +176,7 @@ def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
         assert training["epochs"] >= 1 and training["device"] == "cpu"
         assert (folder / "loss.png").stat().st_size > 1000
         assert pd.read_csv(folder / "history.csv")["validation_nll"].notna().all()
-        saved = torch.load(folder / "model.pt", map_location="cpu", weights_only=False)
+        saved = checkpoint.load(folder / "model.pt", "graph_model").record
         fit, val, held = (set(saved[k]) for k in ("train_ids", "validation_ids", "heldout_ids"))
         assert fit and val and held and not (fit & val) and not ((fit | val) & held)  # the test rooms are never trained on
         assert training["heldout_nll"] == saved["heldout_nll"]["per_graph"] > 0

@@ -131,7 +131,7 @@ def test_metrics_on_real_3d_front_rooms_are_finite_and_agree_with_the_filter(tmp
     than on boxes (an L-sofa's box covers its coffee table); every share is in [0, 1]."""
     from conftest import shared_data
     from pipeline import tables
-    from pipeline.roomdata import room_inputs
+    from pipeline.room import room_inputs
     from test_sources import ingest_outputs, run_ingest
 
     sample = shared_data("3d-front-meshes")
@@ -167,7 +167,7 @@ def _squares(n: int, colour: int, rng: np.random.Generator) -> np.ndarray:
 
 @pytest.mark.parametrize("separable", [True, False])
 def test_the_classifier_separates_separable_renders_and_not_identical_ones(separable):
-    from pipeline.learn.sca import sca
+    from pipeline.evaluation.sca import sca
 
     rng = np.random.default_rng(0)
     cfg = {**default_config()["evaluate"]["sca"], "runs": 3, "steps": 150, "device": "cpu"}

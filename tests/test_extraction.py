@@ -416,7 +416,7 @@ def test_sweeping_some_anchors_on_real_3d_front_rooms(tmp_path):
     """The same on the 3D-FRONT sample's rooms, real 3D-FUTURE meshes."""
     from conftest import shared_data
     from pipeline import tables
-    from pipeline.roomdata import room_inputs
+    from pipeline.room import room_inputs
     from test_sources import run_ingest
 
     sample = shared_data("3d-front-meshes")

@@ -11,8 +11,13 @@ torch = pytest.importorskip("torch")
 from pipeline import config  # noqa: E402
 from pipeline.corpus import procedural_rules  # noqa: E402
 from pipeline.errors import InputError  # noqa: E402
-from pipeline.learn import graph_checks, graph_data, graph_metrics, sampler, spec, train  # noqa: E402
-from pipeline.learn.graph_data import OBJECT_EDGES, Graph  # noqa: E402
+from pipeline.graphs import checks as graph_checks  # noqa: E402
+from pipeline.graphs import data as graph_data  # noqa: E402
+from pipeline.evaluation import graphs as graph_metrics  # noqa: E402
+from pipeline.methods.planit.graph_model import sampler  # noqa: E402
+from pipeline.methods.planit.graph_model import spec  # noqa: E402
+from pipeline.methods.planit.graph_model import train  # noqa: E402
+from pipeline.graphs.data import OBJECT_EDGES, Graph  # noqa: E402
 from conftest import ROOT  # noqa: E402
 
 TINY = {**config.validate({})["graph_model"]["presets"]["tiny"]}
@@ -196,7 +201,7 @@ def test_metrics_separate_equal_and_different_sets(bedrooms):
 
 def test_procedural_rules_hold_on_real_graphs(bedrooms):
     vocab, graphs = bedrooms
-    from pipeline.learn.graph_data import EDGE_CLASSES
+    from pipeline.graphs.data import EDGE_CLASSES
 
     view = [([vocab.node_classes[c] for c in g.node_class], [(s, t, EDGE_CLASSES[c]) for s, t, c in g.edges]) for g in graphs]
     sat = procedural_rules.satisfaction(view)
@@ -206,8 +211,8 @@ def test_procedural_rules_hold_on_real_graphs(bedrooms):
 
 def test_extraction_and_refinement_never_import_torch():
     code = ("import sys; import pipeline.extraction, pipeline.filtering, pipeline.graphs.refine, pipeline.stages.ingest, "
-            "pipeline.stages.extract_graphs, pipeline.stages.refine_graphs, pipeline.cli, pipeline.learn.graph_data, "
-            "pipeline.learn.graph_checks, pipeline.learn.graph_metrics, pipeline.learn.placement_data, "
+            "pipeline.stages.extract_graphs, pipeline.stages.refine_graphs, pipeline.cli, pipeline.graphs.data, "
+            "pipeline.graphs.checks, pipeline.evaluation.graphs, pipeline.methods.planit.nets.data, "
             "pipeline.placement.search, pipeline.placement.checks, pipeline.placement.export, "
             "pipeline.placement.scene_metrics, pipeline.stages.instantiate, pipeline.stages.generate, "
             "pipeline.evaluation.distributions, pipeline.evaluation.physical, pipeline.evaluation.walkability, "
@@ -224,7 +229,7 @@ def test_device_is_chosen_automatically():
 
 def test_batched_training_matches_one_graph_at_a_time(bedrooms):
     """The batch is a disjoint union: the NLL of a graph does not depend on the graphs batched with it."""
-    from pipeline.learn.teacher import make_batch, nll
+    from pipeline.methods.planit.graph_model.teacher import make_batch, nll
 
     vocab, graphs = bedrooms
     torch.manual_seed(0)

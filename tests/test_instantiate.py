@@ -348,8 +348,9 @@ def test_a_reflex_corner_piercing_a_footprint_is_out_of_bounds_for_the_check_and
 
 def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_only_then():
     torch = pytest.importorskip("torch")
-    from pipeline.learn.placement_proposer import NetProposer
-    from pipeline.learn.placement_train import build
+    from pipeline.learning.checkpoint import Checkpoint
+    from pipeline.methods.planit.nets.proposer import NetProposer
+    from pipeline.methods.planit.nets.train import build
     from pipeline.placement.search import Grid, anchors_of
 
     room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
@@ -361,7 +362,9 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
     cats = ("bed", "nightstand", "table_lamp")
     torch.manual_seed(0)
     loc, ori = build(preset, cats, True)
-    nets = NetProposer({"categories": cats, "preset": preset, "nets": [loc.state_dict(), ori.state_dict()]}, 1)
+    saved = Checkpoint("placement_nets", "test", {"nets": [loc.state_dict(), ori.state_dict()]},
+                       {"categories": list(cats), "preset": preset})
+    nets = NetProposer(saved, 1)
     points = Grid(room.outline, 0.1).points
     anchors = anchors_of("ns_l", plan, bed_only, walls, {"bed": "left-right"})
     first = nets.density(bed_only, walls, "nightstand", anchors, points)

@@ -6,8 +6,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..extraction import RoomInput
-from ..filtering import penetrating_pairs
+from ..room import RoomInput
+from ..geometry.collision import penetrating_pairs
 from ..geometry import boxes
 from ..geometry.polygon import outside_area
 

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..extraction import RoomInput
+from ..room import RoomInput
 from ..geometry import boxes
 from ..geometry.raster import fill_quads
 

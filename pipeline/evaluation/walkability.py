@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from ..extraction import RoomInput
+from ..room import RoomInput
 from ..geometry import boxes
 from ..geometry.raster import fill_polygon, fill_quads, pixel_centres
 

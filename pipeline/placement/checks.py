@@ -9,8 +9,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import shapely
 
-from ..extraction import RoomInput, extract_room
-from ..filtering import deepest_penetration
+from ..extraction import extract_room
+from ..room import RoomInput
+from ..geometry.collision import deepest_penetration
 from ..geometry import boxes
 from ..geometry.polygon import door_zones, outside_area
 from .plan import PlanEdge

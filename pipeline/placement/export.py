@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import tables
-from ..extraction import RoomInput, Walls, wall_footprints
+from ..room import RoomInput, Walls, wall_footprints
 from ..geometry import meshes
 from ..geometry.boxes import footprint_corners
 from .plan import PlanEdge

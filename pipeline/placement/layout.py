@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..extraction import RoomInput, Walls, merge_walls
+from ..room import RoomInput, Walls, merge_walls
 from ..geometry import raster
 from ..geometry.frames import Frame, boxes_to_local, to_local
 

@@ -1,13 +1,13 @@
 """Proposers without networks: uniform locations (the "random location" ablation of PlanIT's Table 3) and the
 orientation rule "face away from the nearest wall" (used where no orientation network is given). The network
-proposer is :class:`pipeline.learn.placement_proposer.NetProposer`."""
+proposer is :class:`pipeline.methods.planit.nets.proposer.NetProposer`."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..extraction import RoomInput, Walls
+from ..room import RoomInput, Walls
 from ..geometry.polygon import segment_distances
 from ..geometry.boxes import SIDES
 from ..geometry.frames import to_local

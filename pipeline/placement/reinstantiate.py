@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 
 from ..geometry.raycast import intersector_class
-from ..roomdata import room_inputs
+from ..room import room_inputs
 from . import order, scene_metrics
 from .checks import Checker, checks_config
 from .layout import walls_of, with_objects

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..extraction import BOX_COLUMNS
+from ..room import BOX_COLUMNS
 from ..geometry.boxes import rotation
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..extraction import RoomInput
+from ..room import RoomInput
 from .checks import Checker, collision, edge_cost, found_edges
 from .plan import ScenePlan
 

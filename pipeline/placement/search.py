@@ -22,7 +22,7 @@ from typing import Protocol
 
 import numpy as np
 
-from ..extraction import RoomInput, Walls
+from ..room import RoomInput, Walls
 from ..geometry import raster
 from ..geometry.boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
 from ..geometry.frames import Frame

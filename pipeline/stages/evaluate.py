@@ -16,13 +16,12 @@ import pandas as pd
 from .. import tables
 from ..errors import InputError
 from ..evaluation import distributions, physical, render, walkability
-from ..extraction import RoomInput
 from ..geometry.raycast import intersector_class
-from ..learn.graph_data import split_heldout
+from ..graphs.data import split_heldout
 from ..log import progress
 from ..placement.checks import Checker
 from ..placement.search import SCORED
-from ..roomdata import room_inputs
+from ..room import RoomInput, room_inputs
 
 log = logging.getLogger("planit.evaluate")
 REAL, RETRIEVAL = "real_heldout", "retrieval"
@@ -310,7 +309,7 @@ def _symmetry(path: Path) -> dict:
 def _sca(real_maps: tuple[np.ndarray, np.ndarray], generated: np.ndarray, cfg: dict, threads: int, seed: int) -> dict:
     import torch
 
-    from ..learn.sca import sca
+    from ..evaluation.sca import sca
 
     torch.set_num_threads(max(threads, 1))
     out = sca(real_maps[0], real_maps[1], generated, cfg, seed)

@@ -11,7 +11,7 @@ from ..config import config_hash
 from ..extraction import extract_room
 from ..geometry.raycast import intersector_class
 from ..log import progress
-from ..roomdata import room_inputs
+from ..room import room_inputs
 
 log = logging.getLogger("planit.extract")
 

@@ -57,8 +57,10 @@ def complete(config: dict, room: str, keep: int, folder: Path | None) -> dict:
     plan = replace(plans_from_tables(nodes, edges)[0], scene_id=f"{room}_completed")
     if not 0 <= keep <= len(plan.ids):
         raise InputError(f"--keep: {keep}, but room {room} has {len(plan.ids)} objects")
-    saved = torch.load(_trained(Path("results/placement") / room_type / "cfcn" / "model.pt", "train_placement"),
-                       map_location="cpu", weights_only=False)
+    from ..learning import checkpoint
+    from ..methods.planit.nets.train import KIND
+
+    saved = checkpoint.load(_trained(Path("results/placement") / room_type / "cfcn" / "model.pt", "train_placement"), KIND)
     p = corpus_paths(config)
     ctx = instantiate.load_context(config, room_type, saved, p["rooms"], p["architecture"], p["objects"], p["models"],
                                    p["symmetry"], p["category_sizes"])

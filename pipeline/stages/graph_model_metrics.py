@@ -18,7 +18,7 @@ FLOOR_FACTOR = 1.5
 
 def _rule_view(g, vocab):
     """(categories, edges with kind names) of a graph, for the procedural rules."""
-    from ..learn.graph_data import EDGE_CLASSES
+    from ..graphs.data import EDGE_CLASSES
 
     cats = [vocab.node_classes[c] for c in g.node_class]
     return cats, [(int(s), int(t), EDGE_CLASSES[int(c)]) for s, t, c in g.edges]
@@ -27,13 +27,15 @@ def _rule_view(g, vocab):
 def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, gen_nodes: Path,
         gen_edges: Path, sample_summary: Path, out: Path) -> dict:
     """Write ``metrics.json`` for the room type."""
-    import torch
-
     from ..corpus.procedural_rules import satisfaction
-    from ..learn import graph_data, graph_metrics as gm
+    from ..graphs import data as graph_data
+    from ..evaluation import graphs as gm
     from .train_graph_model import room_graphs
 
-    saved = torch.load(model, map_location="cpu", weights_only=False)
+    from ..learning import checkpoint
+    from ..methods.planit.graph_model.train import KIND
+
+    saved = checkpoint.load(model, KIND).record
     vocab = graph_data.Vocab(tuple(saved["categories"]))
     _, real = room_graphs(nodes, edges, room_type)
     by_id = {g.room_id: g for g in real}

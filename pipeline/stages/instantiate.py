@@ -23,7 +23,7 @@ from ..placement.layout import walls_of, with_objects
 from ..placement.plan import ScenePlan, plans_from_tables
 from ..placement.retrieval import Catalog
 from ..placement.search import SCORED, instantiate
-from .train_placement import load_rooms
+from ..room import load_rooms
 
 log = logging.getLogger("planit.instantiate")
 
@@ -43,13 +43,13 @@ class Context:
     models: list[Path]
 
 
-def load_context(config: dict, room_type: str, saved: dict, rooms: list[Path], architecture: list[Path],
+def load_context(config: dict, room_type: str, saved, rooms: list[Path], architecture: list[Path],
                  objects: list[Path], models: list[Path], symmetry: Path, category_sizes: Path) -> Context:
     room_df, arch, objs, inputs = load_rooms(rooms, architecture, objects)
     keep = room_df["room_type"].astype(str) == room_type
     room_df = room_df[keep]
     objs = objs[objs["room_id"].isin(set(room_df["room_id"]))]
-    held = set(saved["heldout_ids"])
+    held = set(saved.record["heldout_ids"])
     sym_rows = tables.read(symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
     sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
     meshes, box_models = tables.read_meshes_of(models, objs["model_id"].dropna())
@@ -60,13 +60,13 @@ def load_context(config: dict, room_type: str, saved: dict, rooms: list[Path], a
     return Context(room_type, room_df, arch[arch["room_id"].isin(set(room_df["room_id"]))], objs,
                    {k: v for k, v in inputs.items() if k in set(room_df["room_id"])},
                    Catalog(objs[~objs["room_id"].isin(held)], sym, config["floor_contact"]), checker,
-                   dict(zip(sizes["category"].astype(str), sizes["mean_area"])), list(saved["heldout_ids"]), models)
+                   dict(zip(sizes["category"].astype(str), sizes["mean_area"])), list(saved.record["heldout_ids"]), models)
 
 
 def make_proposer(location: str, saved: dict, cfg: dict):
     """The variant's proposer: network densities (weighted by the relation bands when ``relation_mask``), uniform or
     rule-band locations; orientations from the network. ``cfg``: the instantiate section."""
-    from ..learn.placement_proposer import NetProposer
+    from ..methods.planit.nets.proposer import NetProposer
 
     nets = NetProposer(saved, cfg["density_cache"], film=location == "cfcn")
     if location in ("cfcn", "fcn"):
@@ -151,7 +151,10 @@ def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Pat
     if variant_name not in ic["variants"]:
         raise InputError(f"--variant: '{variant_name}' is not in instantiate.variants ({', '.join(ic['variants'])})")
     variant = ic["variants"][variant_name]
-    saved = torch.load(model, map_location="cpu", weights_only=False)
+    from ..learning import checkpoint
+    from ..methods.planit.nets.train import KIND
+
+    saved = checkpoint.load(model, KIND)
     ctx = load_context(config, room_type, saved, rooms, architecture, objects, models, symmetry, category_sizes)
     n = count or scene_count(ic, variant)
     plans = select_plans(config, variant, ctx, nodes, edges, n)

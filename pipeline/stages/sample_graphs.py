@@ -31,17 +31,15 @@ def spec_room_type(spec: Path) -> str:
 
 def load_model(path: Path):
     """The model file's dict and the rebuilt model (weights loaded, on the CPU, eval mode)."""
-    import torch
+    from ..graphs import data as graph_data
+    from ..learning import checkpoint
+    from ..methods.planit.graph_model import train
 
-    from ..learn import graph_data, train
-
-    try:
-        saved = torch.load(path, map_location="cpu", weights_only=False)
-    except (OSError, RuntimeError, EOFError) as exc:
-        raise InputError(f"{path}: not a graph model file ({exc}); rerun snakemake --forcerun train_graph_model") from exc
+    ckpt = checkpoint.load(path, train.KIND)
+    saved = ckpt.record
     vocab = graph_data.Vocab(tuple(saved["categories"]))
     model = train.build_model(vocab, saved["preset"])
-    model.load_state_dict(saved["state_dict"])
+    model.load_state_dict(ckpt.state["model"])
     model.eval()
     return saved, vocab, model
 
@@ -51,7 +49,7 @@ def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out
     """Write ``count`` (default ``graph_model.sample.graphs``) valid graphs and a summary of the sampling."""
     import torch
 
-    from ..learn.spec import load_spec
+    from ..methods.planit.graph_model.spec import load_spec
 
     sc = config["graph_model"]["sample"]
     torch.set_num_threads(threads)
@@ -82,7 +80,7 @@ def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out
 
 
 def _plan_triples(plan) -> set[tuple[int, int, int]]:
-    from ..learn.graph_data import ARCH
+    from ..graphs.data import ARCH
 
     cls = [len(ARCH) + c for c, _, _ in plan.objects]
     return {(cls[k], cls[j], c) if d == 0 else (cls[j], cls[k], c) for k, d, c, j in plan.edges}
@@ -91,8 +89,8 @@ def _plan_triples(plan) -> set[tuple[int, int, int]]:
 def _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, max_edges, room_type) -> tuple[dict, int, Counter]:
     """Graph index -> (valid graph, seed); how many were valid at the first try; rejections by reason. A graph that
     fails the checks is sampled again, up to ``resample_budget`` times."""
-    from ..learn import graph_checks
-    from ..learn.sampler import sample
+    from ..graphs import checks as graph_checks
+    from ..methods.planit.graph_model.sampler import sample
 
     kept, first_try, reasons = {}, 0, Counter()
     pending = list(range(n))
@@ -116,7 +114,7 @@ def _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, max_edges, roo
 
 def _write(kept: dict, vocab, nodes: Path, edges: Path, room_type: str, out_nodes: Path, out_edges: Path) -> None:
     """The kept graphs as generated_nodes / generated_edges rows, architecture copied from their rooms."""
-    from ..learn.graph_tables import grown_rows
+    from ..methods.planit.graph_model.tables import grown_rows
 
     flt = [("room_type", "=", room_type)]
     arch_rows = _architecture_rows(tables.read(nodes, "final_nodes", filters=flt).to_pandas(),

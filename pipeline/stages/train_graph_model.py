@@ -14,7 +14,7 @@ log = logging.getLogger("planit.train_graph_model")
 
 def room_graphs(nodes: Path, edges: Path, room_type: str):
     """The room type's final graphs and their vocabulary."""
-    from ..learn import graph_data
+    from ..graphs import data as graph_data
 
     flt = [("room_type", "=", room_type)]
     node_df = tables.read(nodes, "final_nodes", filters=flt).to_pandas()
@@ -28,7 +28,7 @@ def room_graphs(nodes: Path, edges: Path, room_type: str):
 def splits(room_ids: list[str], gm: dict, seed: int) -> tuple[list[str], list[str], list[str]]:
     """Seeded (fit, validation, test) room ids: the test rooms are the held-out split every evaluation uses; the
     validation rooms come out of the rest."""
-    from ..learn import graph_data
+    from ..graphs import data as graph_data
 
     rest, test = graph_data.split_heldout(room_ids, gm["heldout_fraction"], seed)
     fit, validation = graph_data.split_heldout(rest, gm["validation_fraction"], seed, stream=4343)
@@ -41,7 +41,10 @@ def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path,
     a summary. The checkpoint beside ``out_model`` resumes an interrupted run with the same settings."""
     import torch
 
-    from ..learn import graph_checks, train
+    from ..graphs import checks as graph_checks
+    from ..learning import checkpoint
+
+    from ..methods.planit.graph_model import train
 
     gm = config["graph_model"]
     preset = gm["presets"][gm["preset"]]
@@ -68,11 +71,10 @@ def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path,
                        chash, device, tick)
     test = heldout_scores(run_.model, held_g, vocab, preset, gm["max_edges"], config["seed"], device)
     log.info("held-out NLL of the chosen epoch (%d): %.2f per graph", run_.best_epoch, test["per_graph"])
-    tables.write_atomic(out_model, lambda tmp: torch.save({
-        "config_hash": chash, "room_type": room_type, "categories": list(vocab.categories), "preset": preset,
-        "max_edges": gm["max_edges"], "state_dict": run_.model.state_dict(), "train_ids": fit_ids,
-        "validation_ids": val_ids, "heldout_ids": held_ids, "heldout_nll": test,
-        "seen": sorted(graph_checks.seen_triples(train_g))}, tmp))
+    checkpoint.save(out_model, checkpoint.Checkpoint(train.KIND, chash, {"model": run_.model.state_dict()}, {
+        "room_type": room_type, "categories": list(vocab.categories), "preset": preset, "max_edges": gm["max_edges"],
+        "train_ids": fit_ids, "validation_ids": val_ids, "heldout_ids": held_ids, "heldout_nll": test,
+        "seen": sorted(graph_checks.seen_triples(train_g))}))
     import pandas as pd
 
     history = pd.DataFrame(run_.history)
@@ -85,7 +87,7 @@ def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path,
 
 def heldout_scores(model, held, vocab, preset: dict, max_edges: int, seed: int, device: str) -> dict:
     """The chosen weights' NLL on the held-out (test) graphs, once after training: per graph and per decision."""
-    from ..learn import train
+    from ..methods.planit.graph_model import train
 
     model.eval()
     nll = train.heldout_nll(model, held, vocab, seed, max_edges, preset["batch_size"], device)

@@ -12,24 +12,15 @@ from .. import tables
 from ..config import config_hash
 from ..errors import InputError
 from ..log import progress
-from ..roomdata import room_inputs
+from ..room import load_rooms
 
 log = logging.getLogger("planit.train_placement")
 
 
-def load_rooms(rooms: list[Path], architecture: list[Path], objects: list[Path], ids: set[str] | None = None):
-    """Canonical rows of the kept rooms (``ids``: only these) over every shard, as one RoomInput per room."""
-    flt = [("room_id", "in", sorted(ids))] if ids is not None else None
-    room_df = pd.concat([tables.read(p, "rooms", filters=flt).to_pandas() for p in rooms], ignore_index=True)
-    arch = pd.concat([tables.read(p, "architecture", filters=flt).to_pandas() for p in architecture], ignore_index=True)
-    objs = pd.concat([tables.read(p, "objects", filters=flt).to_pandas() for p in objects], ignore_index=True)
-    return room_df, arch, objs, {r.room_id: r for r in room_inputs(room_df, arch, objs)}
-
-
 def training_rooms(config: dict, room_type: str, rooms, architecture, objects, nodes: Path, edges: Path):
     """Categories, training and held-out :class:`TrainingRoom` lists, and the held-out ids (the graph model's split)."""
-    from ..learn import graph_data
-    from ..learn.placement_data import training_room
+    from ..graphs import data as graph_data
+    from ..methods.planit.nets.data import training_room
 
     flt = [("room_type", "=", room_type)]
     node_df = tables.read(nodes, "final_nodes", filters=flt).to_pandas()
@@ -50,8 +41,9 @@ def run(config: dict, room_type: str, net: str, rooms: list[Path], architecture:
         threads: int = 1) -> dict:
     import torch
 
-    from ..learn import placement_train
-    from ..learn.train import pick_device
+    from ..methods.planit.nets import train as placement_train
+    from ..learning import checkpoint
+    from ..learning.device import pick_device
 
     pc = config["placement"]
     preset = pc["presets"][pc["preset"]]
@@ -71,9 +63,8 @@ def run(config: dict, room_type: str, net: str, rooms: list[Path], architecture:
 
     nets, history = placement_train.train(train_rooms, held_rooms, cats, preset, net == "cfcn", config["seed"],
                                           out_model.with_name("checkpoint.pt"), chash, device, tick)
-    tables.write_atomic(out_model, lambda tmp: torch.save({
-        "config_hash": chash, "room_type": room_type, "net": net, "categories": list(cats), "preset": preset,
-        "nets": [n.cpu().state_dict() for n in nets], "heldout_ids": held_ids}, tmp))
+    checkpoint.save(out_model, checkpoint.Checkpoint(placement_train.KIND, chash, {"nets": [n.cpu().state_dict() for n in nets]}, {
+        "room_type": room_type, "net": net, "categories": list(cats), "preset": preset, "heldout_ids": held_ids}))
     frame = pd.DataFrame(history)
     tables.write_csv(out_history, frame)
     tables.write_figure(out_curve, _curve(frame, room_type, net))

@@ -3,7 +3,7 @@
 Every distance is reported beside its *sampling floor*: the same distance between two disjoint sets of real graphs
 of the sizes compared (held-out vs a sample of training graphs), since small sets differ by chance alone.
 Graphs are anything with ``node_class``, ``role``, ``n_arch`` and ``edges`` rows (source, target, class): the
-:class:`~pipeline.learn.graph_data.Graph` of real or generated tables alike.
+:class:`~pipeline.graphs.data.Graph` of real or generated tables alike.
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from collections import Counter
 import networkx as nx
 import numpy as np
 
-from .graph_data import N_OBJECT_EDGES, ROLES
+from ..graphs.data import N_OBJECT_EDGES, ROLES
 
 EPS = 1e-6  # ATISS's smoothing of the category KL
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import pandas as pd
 
-from .. import tables
-from ..geometry.symmetry import TYPES as SYMMETRIES
-from .graph_data import EDGE_CLASSES, N_OBJECT_EDGES, ROLES, Vocab
+from .... import tables
+from ....geometry.symmetry import TYPES as SYMMETRIES
+from ....graphs.data import EDGE_CLASSES, N_OBJECT_EDGES, ROLES, Vocab
 from .sampler import Grown
 
 ROLE_NAMES = {"none": "none", "hub": "hub", "hub+chain": "hub+chain_member", "spoke": "spoke", "chain": "chain_member"}

@@ -21,8 +21,8 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-from ..errors import InputError
-from .graph_data import OBJECT_EDGES, Vocab
+from ....errors import InputError
+from ....graphs.data import OBJECT_EDGES, Vocab
 from .sampler import Plan
 
 DIRECTION_OF = {"left_of": "left", "right_of": "right", "in_front_of": "front", "behind": "back"}

@@ -9,7 +9,7 @@ import torch
 from torch import nn
 
 from ..log import progress
-from .train import pick_device
+from ..learning.device import pick_device
 
 
 def classifier(width: int) -> nn.Module:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import networkx as nx
 
-from .graph_data import N_OBJECT_EDGES, OBJECT_EDGES, ROLES
+from .data import N_OBJECT_EDGES, OBJECT_EDGES, ROLES
 
 CHAIN_ROLES = {ROLES.index("chain"), ROLES.index("hub+chain")}
 NEAR = {k for k, name in enumerate(OBJECT_EDGES) if name.endswith(("adjacent", "proximal"))}

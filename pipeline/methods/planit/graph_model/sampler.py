@@ -14,8 +14,8 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from .graph_data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, features, node_features
-from .graph_model import EDGE_CHOICES, GraphModel
+from ....graphs.data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, features, node_features
+from .model import EDGE_CHOICES, GraphModel
 from .teacher import candidate_logits, edge_features
 
 

@@ -14,8 +14,8 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from .graph_data import ARCH, N_OBJECT_EDGES, ROLES, Sequence, Vocab, node_features
-from .graph_model import EDGE_CHOICES, EDGE_FEATURES, GraphModel
+from ....graphs.data import ARCH, N_OBJECT_EDGES, ROLES, Sequence, Vocab, node_features
+from .model import EDGE_CHOICES, EDGE_FEATURES, GraphModel
 
 ADD, EDGES = 0, 1
 KINDS = ("add_node", "attributes", "add_edge")

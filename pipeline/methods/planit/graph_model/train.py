@@ -18,19 +18,15 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .. import tables
-from .graph_data import Graph, Vocab, sequence
-from .graph_model import GraphModel
+from .... import tables
+from ....learning import checkpoint as ckpt
+from ....learning.device import pick_device  # noqa: F401 (re-exported for the stages)
+from ....graphs.data import Graph, Vocab, sequence
+from .model import GraphModel
 from .teacher import KINDS, make_batch, nll
 
 log = logging.getLogger("planit.graph_model")
-
-
-def pick_device(setting: str) -> str:
-    """'auto': CUDA when PyTorch sees a GPU, else the CPU."""
-    if setting == "auto":
-        return "cuda" if torch.cuda.is_available() else "cpu"
-    return setting
+KIND, PROGRESS = "graph_model", "graph_model.progress"  # checkpoint kinds: the trained model, training progress
 
 
 def build_model(vocab: Vocab, preset: dict) -> GraphModel:
@@ -91,16 +87,15 @@ def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, pres
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
     state = {"epoch": 0, "history": [], "best": np.inf, "best_epoch": 0, "best_state": None, "stale": 0}
     resumed = 0
-    if checkpoint.exists():
-        saved = torch.load(checkpoint, map_location=device, weights_only=False)
-        if saved.get("config_hash") == config_hash:
-            model.load_state_dict(saved["model"])
-            opt.load_state_dict(saved["optimizer"])
-            state = saved["state"]
-            resumed = state["epoch"]
-            log.info("resumed from %s after epoch %d", checkpoint, resumed)
-        else:
-            log.info("checkpoint %s is for other settings: starting afresh", checkpoint)
+    saved = ckpt.resume(checkpoint, PROGRESS, config_hash, device)
+    if saved is not None:
+        model.load_state_dict(saved.state["model"])
+        opt.load_state_dict(saved.state["optimizer"])
+        state = {**saved.record, "best_state": saved.state["best_state"]}
+        resumed = state["epoch"]
+        log.info("resumed from %s after epoch %d", checkpoint, resumed)
+    elif checkpoint.exists():
+        log.info("checkpoint %s is for other settings: starting afresh", checkpoint)
     while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
         epoch = state["epoch"] + 1
         start = time.perf_counter()
@@ -120,8 +115,9 @@ def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, pres
         if row["validation_nll"] < state["best"]:
             state.update(best=row["validation_nll"], best_epoch=epoch, best_state=copy.deepcopy(model.state_dict()))
         state["epoch"] = epoch
-        tables.write_atomic(checkpoint, lambda tmp: torch.save({"config_hash": config_hash, "model": model.state_dict(),
-                                                                "optimizer": opt.state_dict(), "state": state}, tmp))
+        ckpt.save(checkpoint, ckpt.Checkpoint(PROGRESS, config_hash, {
+            "model": model.state_dict(), "optimizer": opt.state_dict(), "best_state": state["best_state"]},
+            {k: v for k, v in state.items() if k != "best_state"}))
         if progress:
             progress(epoch, row)
     if state["best_state"] is not None:

@@ -13,11 +13,12 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .. import tables
-from ..placement.layout import View
-from .placement_data import TrainingRoom, batch
-from .placement_nets import LocationNet, OrientationNet, location_loss, orientation_loss
+from ....learning import checkpoint as ckpt
+from ....placement.layout import View
+from .data import TrainingRoom, batch
+from .model import LocationNet, OrientationNet, location_loss, orientation_loss
 
+KIND, PROGRESS = "placement_nets", "placement_nets.progress"  # checkpoint kinds
 log = logging.getLogger("planit.placement")
 
 
@@ -51,14 +52,13 @@ def train(rooms: list[TrainingRoom], held: list[TrainingRoom], categories: tuple
     draw = lambda pool, s, step: _tensors(batch(pool, s, step, preset["batch_size"], loc_view, ori_view, preset["bins"]), device)
     fixed = draw(held or rooms, seed + 1, 0)
     state = {"step": 0, "history": []}
-    if checkpoint.exists():
-        saved = torch.load(checkpoint, map_location=device, weights_only=False)
-        if saved.get("config_hash") == config_hash:
-            for n, sd in zip(nets, saved["nets"]):
-                n.load_state_dict(sd)
-            opt.load_state_dict(saved["optimizer"])
-            state = saved["state"]
-            log.info("resumed from %s after step %d", checkpoint, state["step"])
+    saved = ckpt.resume(checkpoint, PROGRESS, config_hash, device)
+    if saved is not None:
+        for n, sd in zip(nets, saved.state["nets"]):
+            n.load_state_dict(sd)
+        opt.load_state_dict(saved.state["optimizer"])
+        state = saved.record
+        log.info("resumed from %s after step %d", checkpoint, state["step"])
     start, window = time.perf_counter(), []
     while state["step"] < preset["steps"]:
         state["step"] += 1
@@ -82,8 +82,8 @@ def train(rooms: list[TrainingRoom], held: list[TrainingRoom], categories: tuple
             if progress:
                 progress(state["step"], row)
         if state["step"] % preset["checkpoint_every"] == 0 or state["step"] == preset["steps"]:
-            tables.write_atomic(checkpoint, lambda tmp: torch.save({"config_hash": config_hash, "nets": [n.state_dict() for n in nets],
-                                                                    "optimizer": opt.state_dict(), "state": state}, tmp))
+            ckpt.save(checkpoint, ckpt.Checkpoint(PROGRESS, config_hash, {"nets": [n.state_dict() for n in nets],
+                                                                           "optimizer": opt.state_dict()}, state))
     for n in nets:
         n.eval()
     return nets, state["history"]

@@ -1,12 +1,15 @@
-"""Canonical tables -> per-room :class:`~pipeline.extraction.RoomInput` arrays (one pass, no per-row pandas)."""
+"""Canonical tables -> per-room :class:`~pipeline.room.RoomInput` arrays (one pass, no per-row pandas), and the one
+reader of the kept rooms over every shard."""
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Iterator
 
 import numpy as np
 import pandas as pd
 
-from .extraction import BOX_COLUMNS, POSE_COLUMNS, RoomInput
+from .. import tables
+from .model import BOX_COLUMNS, POSE_COLUMNS, RoomInput
 
 
 def room_slices(frame: pd.DataFrame) -> dict[str, slice]:
@@ -49,3 +52,12 @@ def room_inputs(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.Dat
             wall_thickness=a_thick[sa][wall], openings=openings,
             object_ids=o_ids[so].tolist(), categories=o_cat[so].tolist(), model_ids=o_model[so].tolist(),
             boxes=o_box[so].reshape(-1, 7), poses=o_pose[so].reshape(-1, 7))
+
+
+def load_rooms(rooms: list[Path], architecture: list[Path], objects: list[Path], ids: set[str] | None = None):
+    """Canonical rows of the kept rooms (``ids``: only these) over every shard, as one RoomInput per room."""
+    flt = [("room_id", "in", sorted(ids))] if ids is not None else None
+    room_df = pd.concat([tables.read(p, "rooms", filters=flt).to_pandas() for p in rooms], ignore_index=True)
+    arch = pd.concat([tables.read(p, "architecture", filters=flt).to_pandas() for p in architecture], ignore_index=True)
+    objs = pd.concat([tables.read(p, "objects", filters=flt).to_pandas() for p in objects], ignore_index=True)
+    return room_df, arch, objs, {r.room_id: r for r in room_inputs(room_df, arch, objs)}

@@ -9,11 +9,12 @@ from collections import OrderedDict
 import numpy as np
 import torch
 
-from ..extraction import RoomInput, Walls
-from ..geometry.frames import equivalent_frames, side_in, to_local, yaw_to_world
-from ..placement.layout import render
-from .placement_data import condition, orientation_frame
-from .placement_train import build, views
+from ....learning.checkpoint import Checkpoint
+from ....room import RoomInput, Walls
+from ....geometry.frames import equivalent_frames, side_in, to_local, yaw_to_world
+from ....placement.layout import render
+from .data import condition, orientation_frame
+from .train import build, views
 
 FLOOR = 1e-3  # an anchor's map never drops below this share of its peak (a window may miss part of the room)
 
@@ -50,12 +51,12 @@ class Memo:
 
 
 class NetProposer:
-    def __init__(self, saved: dict, cache_size: int, film: bool = True, device: str = "cpu"):
-        self.categories = tuple(saved["categories"])
-        self.preset = saved["preset"]
+    def __init__(self, saved: Checkpoint, cache_size: int, film: bool = True, device: str = "cpu"):
+        self.categories = tuple(saved.record["categories"])
+        self.preset = saved.record["preset"]
         self.loc, self.ori = build(self.preset, self.categories, film)
-        self.loc.load_state_dict(saved["nets"][0])
-        self.ori.load_state_dict(saved["nets"][1])
+        self.loc.load_state_dict(saved.state["nets"][0])
+        self.ori.load_state_dict(saved.state["nets"][1])
         self.loc.eval()
         self.ori.eval()
         self.loc_view, self.ori_view = views(self.preset, self.categories)

@@ -10,11 +10,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..extraction import RoomInput, Walls
-from ..geometry.frames import Frame, equivalent_frames, side_in, to_local, yaw_to_local
-from ..placement.layout import View, box_frame, render, wall_frame, walls_of, with_objects
-from ..placement.proposers import nearest_wall
-from .graph_data import DIRECTIONS, DISTANCES
+from ....room import RoomInput, Walls
+from ....geometry.frames import Frame, equivalent_frames, side_in, to_local, yaw_to_local
+from ....placement.layout import View, box_frame, render, wall_frame, walls_of, with_objects
+from ....placement.proposers import nearest_wall
+from ....graphs.data import DIRECTIONS, DISTANCES
 
 
 @dataclass
