@@ -18,6 +18,7 @@ import json
 import tempfile
 from pathlib import Path
 
+from pipeline.stage import Files
 from pipeline import config as config_mod
 from pipeline import tables
 from pipeline.evaluation import distributions
@@ -35,9 +36,10 @@ def sampled_categories(cfg: dict, run: Path, room_type: str, graphs: int, tmp: P
     g = run / "results" / "graphs" / "ingested"
     out = tmp / room_type
     out.mkdir(parents=True, exist_ok=True)
-    summary = sample_graphs.run(cfg, room_type, run / "results" / "graph_model" / room_type / "model.pt",
-                                g / "nodes.parquet", g / "edges.parquet", out / "nodes.parquet", out / "edges.parquet",
-                                out / "summary.json", count=graphs)
+    summary = sample_graphs.run(cfg, Files(model=run / "results" / "graph_model" / room_type / "model.pt",
+                                           nodes=g / "nodes.parquet", edges=g / "edges.parquet", spec=None),
+                                Files(nodes=out / "nodes.parquet", edges=out / "edges.parquet", summary=out / "summary.json"),
+                                room_type=room_type, count=graphs)
     return graph_categories(out / "nodes.parquet"), summary
 
 

@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from pipeline.stage import Files
 from pipeline import config as config_mod
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -70,10 +71,25 @@ def ingest_and_filter(cfg: dict, p: dict[str, Path]) -> tuple[dict, object, floa
     from pipeline.stages import filter_rooms, ingest, ingest_summary
 
     t = time.perf_counter()
-    counts = ingest.run(cfg, 0, {n: p[n] for n in ingest.OUTPUTS})
-    ingest_summary.run([p["rooms"]], [p["objects"]], [p["models"]], [p["ingest_report"]], [p["drops"]], p["counts"],
-                       p["summary"], p["all_drops"])
+    counts = ingest.run(cfg, Files(), Files({n: p[n] for n in ingest.OUTPUTS}), shard=0)
+    ingest_summary.run(cfg, Files(rooms=[p["rooms"]], objects=[p["objects"]], models=[p["models"]],
+                                  reports=[p["ingest_report"]], drops=[p["drops"]]),
+                       Files(counts=p["counts"], report=p["summary"], drops=p["all_drops"]))
     t_ingest = time.perf_counter() - t
     t = time.perf_counter()
-    filter_rooms.run(cfg, p["rooms"], p["architecture"], p["objects"], p["models"], p["counts"], p["kept"], p["filter_report"])
+    filter_rooms.run(cfg, Files(rooms=p["rooms"], architecture=p["architecture"], objects=p["objects"], models=p["models"],
+                                counts=p["counts"]), Files(rooms=p["kept"], report=p["filter_report"]))
     return counts, pd.read_parquet(p["filter_report"]), t_ingest, time.perf_counter() - t
+
+
+def corpus_paths(config: dict) -> dict:
+    """The kept corpus's canonical tables per shard, the symmetry and category-size tables (workflow layout)."""
+    shards = range(config["shards"])
+    rooms = [Path(f"results/filter/shards/rooms-{k}.parquet") for k in shards]
+    if not all(p.exists() for p in rooms):
+        raise SystemExit(f"{rooms[0].parent}: the filter's {config['shards']} shard(s) are not all there; run the "
+                         "pipeline first, or give the config it ran with (--config; default config/config.yaml)")
+    return {"rooms": rooms,
+            **{t: [Path(f"results/ingest/shards/{t}-{k}.parquet") for k in shards] for t in ("architecture", "objects", "models")},
+            "symmetry": Path("results/graphs/ingested/symmetry.parquet"),
+            "category_sizes": Path("results/graphs/ingested/stats/category_sizes.parquet")}

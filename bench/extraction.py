@@ -12,6 +12,7 @@ import time
 import warnings
 from pathlib import Path
 
+from pipeline.stage import Files
 from pipeline.extraction import extract_room
 from pipeline.geometry.raycast import intersector_class
 from pipeline.room import room_inputs
@@ -26,7 +27,7 @@ def corpus(workdir: Path, cfg: dict) -> dict[str, Path]:
     if not p["kept"].exists():
         ingest_and_filter(cfg, p)
     if not p["symmetry"].exists():
-        symmetry.run(cfg, [p["models"]], p["symmetry"], p["agreement"])
+        symmetry.run(cfg, Files(models=[p["models"]]), Files(table=p["symmetry"], agreement=p["agreement"]))
     return p
 
 

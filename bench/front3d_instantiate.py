@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline.stage import Files
 from pipeline import config as config_mod
 from pipeline import tables
 from pipeline.placement.reinstantiate import own_plans, reinstantiate, summary
@@ -33,10 +34,11 @@ def main() -> None:
         "instantiate": search_overrides(args)})
     ing = w / "ingest"
     outs = {t: ing / f"{t}-0.parquet" for t in ingest.OUTPUTS}
-    ingest.run(cfg, 0, outs)
-    symmetry.run(cfg, [outs["models"]], w / "sym.parquet", w / "sym.json")
-    extract_graphs.run(cfg, 0, outs["rooms"], outs["architecture"], outs["objects"], outs["models"], w / "sym.parquet",
-                       w / "nodes.parquet", w / "edges.parquet", w / "extract.json")
+    ingest.run(cfg, Files(), Files(outs), shard=0)
+    symmetry.run(cfg, Files(models=[outs["models"]]), Files(table=w / "sym.parquet", agreement=w / "sym.json"))
+    extract_graphs.run(cfg, Files(rooms=outs["rooms"], architecture=outs["architecture"], objects=outs["objects"],
+                                  models=outs["models"], symmetry=w / "sym.parquet"),
+                       Files(nodes=w / "nodes.parquet", edges=w / "edges.parquet", summary=w / "extract.json"), shard=0)
     t = {k: pd.read_parquet(outs[k]) for k in ("rooms", "architecture", "objects")}
     meshes, box_models = tables.read_meshes(outs["models"], t["objects"]["model_id"].dropna())
     sym = {r["model_id"]: r["symmetry"] for r in tables.read(w / "sym.parquet", "symmetry").to_pylist()}

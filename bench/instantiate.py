@@ -34,15 +34,15 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement import scene_metrics
 from pipeline.placement.proposers import FaceAway
 from pipeline.placement.search import Grid, anchors_of
-from pipeline.stages import generate, instantiate, train_placement
+from pipeline.stages import instantiate, train_placement
 
-from common import ROOT, arguments, report, search_flags, search_overrides, search_suffix
+from common import ROOT, arguments, corpus_paths, report, search_flags, search_overrides, search_suffix
 
 
 def probe_networks(cfg, room_type: str, saved: dict, probes: int, checker) -> dict:
     """On held-out rooms, remove one object at a time and ask the networks for it; and the held-out real rooms'
     collision rate (objects penetrating another deeper than the search allows, same measure)."""
-    p = generate.corpus_paths(cfg)
+    p = corpus_paths(cfg)
     _, _, held, _ = train_placement.training_rooms(cfg, room_type, p["rooms"], p["architecture"], p["objects"],
                                                    ROOT / "results/graphs/ingested/nodes.parquet",
                                                    ROOT / "results/graphs/ingested/edges.parquet")
@@ -98,7 +98,7 @@ def main() -> None:
     if args.density_cache:
         cfg["instantiate"]["density_cache"] = args.density_cache
     saved = checkpoint.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", "placement_nets")
-    p = generate.corpus_paths(cfg)
+    p = corpus_paths(cfg)
     ctx = instantiate.load_context(cfg, args.room_type, saved, p["rooms"], p["architecture"], p["objects"], p["models"],
                                    p["symmetry"], p["category_sizes"])
     if args.no_confirm:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import time
 
+from pipeline.stage import Files
 from pipeline.stages import extract_graphs, graph_statistics, refine_graphs, shard_statistics
 
 from common import arguments, default_config, report, shard_paths
@@ -20,19 +21,21 @@ def main() -> None:
     cfg = default_config()
     raw = {n: w / "raw1" / f"{n}-0.parquet" for n in ("nodes", "edges")}
     t = time.perf_counter()
-    ex = extract_graphs.run(cfg, 0, p["kept"], p["architecture"], p["objects"], p["models"], p["symmetry"],
-                            raw["nodes"], raw["edges"], w / "raw1" / "summary-0.json")
+    ex = extract_graphs.run(cfg, Files(rooms=p["kept"], architecture=p["architecture"], objects=p["objects"],
+                                       models=p["models"], symmetry=p["symmetry"]),
+                            Files(nodes=raw["nodes"], edges=raw["edges"], summary=w / "raw1" / "summary-0.json"), shard=0)
     t_extract = time.perf_counter() - t
     stats = {n: w / "stats1" / f"{n}.parquet" for n in graph_statistics.STAT_TABLES}
     t = time.perf_counter()
-    shard_statistics.run(cfg, raw["nodes"], raw["edges"], w / "stats1" / "partial-0.parquet",
-                         w / "stats1" / "candidates-0.parquet")
-    graph_statistics.run(cfg, [w / "stats1" / "partial-0.parquet"], [raw["nodes"]], stats)
+    shard_statistics.run(cfg, Files(nodes=raw["nodes"], edges=raw["edges"]),
+                         Files(counts=w / "stats1" / "partial-0.parquet", candidates=w / "stats1" / "candidates-0.parquet"))
+    graph_statistics.run(cfg, Files(partial=[w / "stats1" / "partial-0.parquet"], nodes=[raw["nodes"]]), Files(stats))
     t_stats = time.perf_counter() - t
     outs = {n: w / "final1" / f"{n}-0.parquet" for n in ("nodes", "edges", "superstructures")}
     outs["summary"] = w / "final1" / "summary-0.json"
     t = time.perf_counter()
-    summary = refine_graphs.run(cfg, 0, raw["nodes"], raw["edges"], w / "stats1" / "candidates-0.parquet", stats, outs)
+    summary = refine_graphs.run(cfg, Files(nodes=raw["nodes"], edges=raw["edges"], candidates=w / "stats1" / "candidates-0.parquet",
+                                           **stats), Files(outs), shard=0)
     t_refine = time.perf_counter() - t
     result = {"rooms": summary["rooms"], "extract_stage_seconds": round(t_extract, 2),
               "extract_stage_rooms_per_s": round(ex["rooms"] / t_extract, 1),

@@ -17,6 +17,8 @@ try:  # the CLI's validator: same defaults, and a bad key is named in one line
 except planit_config.ConfigError as exc:
     raise WorkflowError(str(exc)) from None
 
+from pipeline.stage import option
+from pipeline.stages import STAGES
 from pipeline.workflow import prepare_jobs
 
 prepare_jobs(workflow.basedir)  # jobs find the `planit` beside this Python; each sees only its rule's keys
@@ -86,18 +88,43 @@ def instantiate_keys(wildcards):
                 "evaluate.collision.penetration")
 
 
+# Every stage rule runs its subcommand (named as the rule) with its named input and output files as options.
+STAGE = "planit {rule} --config-json {params.config:q} {params.io} --threads {threads} 2> {log}"
+UNPASSED_WILDCARDS = {"corpus"}  # wildcards that only choose paths, not what a stage computes
+
+
+def stage_io(name):
+    """Params function of rule ``name``: ``--in-port path`` for each of its named inputs (repeated for lists),
+    ``--out-port path`` for each named output, ``--wildcard value`` for the wildcards the stage takes; the rule's
+    named files must be exactly the stage's declared ports (``pipeline.stages.STAGES``)."""
+    if name not in STAGES:
+        raise WorkflowError(f"rule {name}: no stage of that name in pipeline.stages.STAGES")
+    stage = STAGES[name]
+
+    def options(wildcards, input, output):
+        for kind, ports, files in (("input", stage.inputs, input), ("output", stage.outputs, output)):
+            given, declared = set(files.keys()), {p.name for p in ports}
+            required = {p.name for p in ports if not p.optional}
+            if not required <= given <= declared:
+                raise WorkflowError(f"rule {name}: named {kind}s {sorted(given)}, but the stage declares "
+                                    f"{sorted(declared)} ({sorted(required)} required)")
+        parts = []
+        for output, ports, files in ((False, stage.inputs, input), (True, stage.outputs, output)):
+            for p in ports:
+                if p.name in files.keys():
+                    value = getattr(files, p.name)
+                    paths = [value] if isinstance(value, str) else list(value)
+                    parts += [f"{option(p, output)} {shlex.quote(str(v))}" for v in paths]
+        parts += [f"--{p.name.replace('_', '-')} {shlex.quote(str(wildcards[p.name]))}" for p in stage.params
+                  if p.name in wildcards.keys() and p.name not in UNPASSED_WILDCARDS]
+        return " ".join(parts)
+
+    return options
+
+
 def shards_of(template, **fixed):
     """Every shard's path of a template (a gather's input)."""
     return expand(template, shard=SHARDS, allow_missing=True, **fixed)
-
-
-def repeat(flag, name):
-    """Params function: `--flag path` for each file of the named input (the CLI takes lists as repeated options)."""
-
-    def options(wildcards, input):
-        return " ".join(f"{flag} {shlex.quote(str(p))}" for p in input[name])
-
-    return options
 
 
 # ------------------------------------------------------------------------------------------- corpora
@@ -144,11 +171,6 @@ def get_instantiate_inputs(wildcards):
         graphs = {t: GATHERED.format(corpus="ingested", table=t) for t in ("nodes", "edges")}
     net = "fcn" if spec["location"] == "fcn" else "cfcn"
     return {**graphs, "model": PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")}
-
-
-def generated_options(wildcards, input):
-    """Params function: `--generated NAME=FOLDER` for the default variant and each baseline."""
-    return " ".join(f"--generated {v}={shlex.quote(str(Path(p).parent))}" for v, p in zip(EVAL_SETS, input.summaries))
 
 
 def get_final_outputs():

@@ -5,6 +5,11 @@
 rule evaluate:
     input:
         summaries=expand(GENERATED, variant=EVAL_SETS, name="summary.json", allow_missing=True),
+        generated_rooms=expand(GENERATED, variant=EVAL_SETS, name="rooms.parquet", allow_missing=True),
+        generated_architecture=expand(GENERATED, variant=EVAL_SETS, name="architecture.parquet", allow_missing=True),
+        generated_objects=expand(GENERATED, variant=EVAL_SETS, name="objects.parquet", allow_missing=True),
+        generated_scenes=expand(GENERATED, variant=EVAL_SETS, name="scenes.parquet", allow_missing=True),
+        generated_files=expand(GENERATED, variant=EVAL_SETS, name="scenes", allow_missing=True),
         rooms=shards_of(FILTER_ROOMS),
         architecture=shards_of(INGEST, table="architecture"),
         objects=shards_of(INGEST, table="objects"),
@@ -22,11 +27,7 @@ rule evaluate:
                        labels={"room type": "{room_type}", "room": "{name}"}),
     params:
         config=keys("seed", "source", "graph_model.heldout_fraction", "extract", "floor_contact", "evaluate"),
-        generated=generated_options,
-        rooms=repeat("--rooms", "rooms"),
-        architecture=repeat("--architecture", "architecture"),
-        objects=repeat("--objects", "objects"),
-        models=repeat("--models", "models"),
+        io=stage_io("evaluate"),
     threads: 1
     log:
         "logs/evaluate/{room_type}.log",
@@ -35,21 +36,20 @@ rule evaluate:
     conda:
         ENV
     shell:
-        "planit evaluate --config-json {params.config:q} --room-type {wildcards.room_type} {params.generated} "
-        "{params.rooms} {params.architecture} {params.objects} {params.models} --nodes {input.nodes} --edges {input.edges} "
-        "--symmetry {input.symmetry} "
-        "--out-metrics {output.metrics} --out-scenes {output.scenes} --out-table {output.table} "
-        "--out-gallery {output.gallery} --threads {threads} 2> {log}"
+        STAGE
 
 
 rule runtime:
     input:
-        pipeline_outputs(),
+        done=pipeline_outputs(),
     output:
         table=report(RUNTIME, caption="../report/runtime.rst", category="7. Run time"),
+    params:
+        config=keys(),
+        io=stage_io("runtime"),
     log:
         "logs/runtime/runtime.log",
     conda:
         ENV
     shell:
-        "planit runtime --benchmarks benchmarks --out {output.table} 2> {log}"
+        STAGE

@@ -9,7 +9,7 @@ rule symmetry:
         agreement=SYMMETRY_AGREEMENT,
     params:
         config=keys("seed", "extract.symmetry"),
-        models=repeat("--models", "models"),
+        io=stage_io("symmetry"),
     log:
         "logs/symmetry/{corpus}.log",
     benchmark:
@@ -17,8 +17,7 @@ rule symmetry:
     conda:
         ENV
     shell:
-        "planit symmetry --config-json {params.config:q} {params.models} --out-table {output.table} "
-        "--out-agreement {output.agreement} 2> {log}"
+        STAGE
 
 
 rule extract_graphs:
@@ -32,6 +31,7 @@ rule extract_graphs:
     params:
         config=keys("extract.backend", "extract.support", "extract.spatial", "extract.distance", "extract.architecture",
                     "floor_contact"),
+        io=stage_io("extract_graphs"),
     log:
         "logs/extract_graphs/{corpus}-{shard}.log",
     benchmark:
@@ -39,10 +39,7 @@ rule extract_graphs:
     conda:
         ENV
     shell:
-        "planit extract --shard {wildcards.shard} --config-json {params.config:q} --rooms {input.rooms} "
-        "--architecture {input.architecture} --objects {input.objects} --models {input.models} "
-        "--symmetry {input.symmetry} --out-nodes {output.nodes} --out-edges {output.edges} "
-        "--out-summary {output.summary} 2> {log}"
+        STAGE
 
 
 rule score_extraction:
@@ -53,9 +50,8 @@ rule score_extraction:
     output:
         metrics=METRICS.replace("{name}", "extraction"),
     params:
-        nodes=repeat("--nodes", "nodes"),
-        edges=repeat("--edges", "edges"),
-        ground_truth=repeat("--ground-truth", "ground_truth"),
+        config=keys(),
+        io=stage_io("score_extraction"),
     log:
         "logs/score_extraction/{corpus}.log",
     benchmark:
@@ -63,4 +59,4 @@ rule score_extraction:
     conda:
         ENV
     shell:
-        "planit score {params.nodes} {params.edges} {params.ground_truth} --out {output.metrics} > {log} 2>&1"
+        STAGE

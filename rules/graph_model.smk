@@ -14,6 +14,7 @@ rule train_graph_model:
         summary=GRAPH_MODEL.replace("{name}", "training.json"),
     params:
         config=keys("seed", *(f"graph_model.{k}" for k in GRAPH_TRAIN_KEYS)),
+        io=stage_io("train_graph_model"),
     threads: 1  # more per job: set-threads in a profile
     resources:
         gpu=1 if config["graph_model"]["device"] == "cuda" else 0,
@@ -24,9 +25,7 @@ rule train_graph_model:
     conda:
         ENV
     shell:
-        "planit train-graph-model --config-json {params.config:q} --room-type {wildcards.room_type} --threads {threads} "
-        "--nodes {input.nodes} --edges {input.edges} --out-model {output.model} --out-history {output.history} "
-        "--out-curve {output.curve} --out-summary {output.summary} 2> {log}"
+        STAGE
 
 
 rule sample_graphs:
@@ -40,6 +39,7 @@ rule sample_graphs:
         summary=GRAPH_MODEL.replace("{name}", "sampled/summary.json"),
     params:
         config=keys("seed", "graph_model.sample"),
+        io=stage_io("sample_graphs"),
     threads: 1
     log:
         "logs/sample_graphs/{room_type}.log",
@@ -48,10 +48,7 @@ rule sample_graphs:
     conda:
         ENV
     shell:
-        "planit sample-graphs --config-json {params.config:q} --room-type {wildcards.room_type} --threads {threads} "
-        "--model {input.model} "
-        "--nodes {input.nodes} --edges {input.edges} --out-nodes {output.nodes} --out-edges {output.edges} "
-        "--out-summary {output.summary} 2> {log}"
+        STAGE
 
 
 rule graph_model_metrics:
@@ -66,6 +63,7 @@ rule graph_model_metrics:
         metrics=GRAPH_MODEL.replace("{name}", "metrics.json"),
     params:
         config=keys("seed", "source"),
+        io=stage_io("graph_model_metrics"),
     log:
         "logs/graph_model_metrics/{room_type}.log",
     benchmark:
@@ -73,7 +71,4 @@ rule graph_model_metrics:
     conda:
         ENV
     shell:
-        "planit graph-model-metrics --config-json {params.config:q} --room-type {wildcards.room_type} "
-        "--model {input.model} --nodes {input.nodes} --edges {input.edges} "
-        "--gen-nodes {input.gen_nodes} --gen-edges {input.gen_edges} --sample-summary {input.sample_summary} "
-        "--out {output.metrics} 2> {log}"
+        STAGE

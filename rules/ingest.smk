@@ -6,6 +6,7 @@ rule ingest:
         **{t: INGEST.replace("{table}", t) for t in INGEST_TABLES},
     params:
         config=keys("seed", "source", "shards", config["source"]),
+        io=stage_io("ingest"),
     log:
         "logs/ingest/{shard}.log",
     benchmark:
@@ -13,9 +14,7 @@ rule ingest:
     conda:
         ENV
     shell:
-        "planit ingest --shard {wildcards.shard} --config-json {params.config:q} --rooms {output.rooms} "
-        "--architecture {output.architecture} --objects {output.objects} --models {output.models} "
-        "--ground-truth {output.ground_truth} --report {output.ingest_report} --drops {output.drops} 2> {log}"
+        STAGE
 
 
 rule ingest_summary:
@@ -30,11 +29,8 @@ rule ingest_summary:
         report=INGEST_REPORT,
         drops=DROPS,
     params:
-        rooms=repeat("--rooms", "rooms"),
-        objects=repeat("--objects", "objects"),
-        models=repeat("--models", "models"),
-        reports=repeat("--report", "reports"),
-        drops=repeat("--drops", "drops"),
+        config=keys(),
+        io=stage_io("ingest_summary"),
     log:
         "logs/ingest_summary/ingest_summary.log",
     benchmark:
@@ -42,8 +38,7 @@ rule ingest_summary:
     conda:
         ENV
     shell:
-        "planit ingest-summary {params.rooms} {params.objects} {params.models} {params.reports} {params.drops} "
-        "--out-counts {output.counts} --out-report {output.report} --out-drops {output.drops} 2> {log}"
+        STAGE
 
 
 rule filter_rooms:
@@ -58,6 +53,7 @@ rule filter_rooms:
         report=FILTER_SHARD_REPORT,
     params:
         config=keys("filter", "floor_contact", "extract.backend"),
+        io=stage_io("filter_rooms"),
     log:
         "logs/filter_rooms/{shard}.log",
     benchmark:
@@ -65,8 +61,7 @@ rule filter_rooms:
     conda:
         ENV
     shell:
-        "planit filter --config-json {params.config:q} --rooms {input.rooms} --architecture {input.architecture} "
-        "--objects {input.objects} --models {input.models} --counts {input.counts} --out-rooms {output.rooms} --out-report {output.report} 2> {log}"
+        STAGE
 
 
 rule filter_report:
@@ -76,7 +71,8 @@ rule filter_report:
         report=FILTER_REPORT,
         counts=report(RULE_COUNTS, caption="../report/filter_counts.rst", category="1. Ingest and filter"),
     params:
-        reports=repeat("--report", "reports"),
+        config=keys(),
+        io=stage_io("filter_report"),
     log:
         "logs/filter_report/filter_report.log",
     benchmark:
@@ -84,4 +80,4 @@ rule filter_report:
     conda:
         ENV
     shell:
-        "planit filter-report {params.reports} --out-report {output.report} --out-counts {output.counts} > {log} 2>&1"
+        STAGE

@@ -18,9 +18,7 @@ rule train_placement:
         summary=PLACEMENT.replace("{name}", "training.json"),
     params:
         config=keys("seed", "graph_model.heldout_fraction", *(f"placement.{k}" for k in PLACEMENT_TRAIN_KEYS)),
-        rooms=repeat("--rooms", "rooms"),
-        architecture=repeat("--architecture", "architecture"),
-        objects=repeat("--objects", "objects"),
+        io=stage_io("train_placement"),
     threads: 1  # more per job: set-threads in a profile
     resources:
         gpu=1 if config["placement"]["device"] == "cuda" else 0,
@@ -31,10 +29,7 @@ rule train_placement:
     conda:
         ENV
     shell:
-        "planit train-placement --config-json {params.config:q} --room-type {wildcards.room_type} --net {wildcards.net} "
-        "--threads {threads} {params.rooms} {params.architecture} {params.objects} --nodes {input.nodes} "
-        "--edges {input.edges} --out-model {output.model} --out-history {output.history} --out-curve {output.curve} "
-        "--out-summary {output.summary} 2> {log}"
+        STAGE
 
 
 rule instantiate:
@@ -56,11 +51,7 @@ rule instantiate:
         files=directory(GENERATED.replace("{name}", "scenes")),
     params:
         config=instantiate_keys,
-        rooms=repeat("--rooms", "rooms"),
-        architecture=repeat("--architecture", "architecture"),
-        objects=repeat("--objects", "objects"),
-        models=repeat("--models", "models"),
-        folder=subpath(output.summary, parent=True),
+        io=stage_io("instantiate"),
     threads: 1
     log:
         "logs/instantiate/{room_type}-{variant}.log",
@@ -69,10 +60,7 @@ rule instantiate:
     conda:
         ENV
     shell:
-        "planit instantiate --config-json {params.config:q} --room-type {wildcards.room_type} "
-        "--variant {wildcards.variant} --threads {threads} --nodes {input.nodes} --edges {input.edges} --model {input.model} "
-        "{params.rooms} {params.architecture} {params.objects} {params.models} --symmetry {input.symmetry} "
-        "--category-sizes {input.category_sizes} --out {params.folder} 2> {log}"
+        STAGE
 
 
 rule table3:
@@ -82,7 +70,8 @@ rule table3:
         table=report(TABLE3, caption="../report/table3.rst", category="4. Instantiation (Table 3)",
                      labels={"room type": "{room_type}"}),
     params:
-        summaries=repeat("--summary", "summaries"),
+        config=keys(),
+        io=stage_io("table3"),
     log:
         "logs/table3/{room_type}.log",
     benchmark:
@@ -90,4 +79,4 @@ rule table3:
     conda:
         ENV
     shell:
-        "planit table3 {params.summaries} --out {output.table} 2> {log}"
+        STAGE

@@ -12,6 +12,7 @@ rule shard_statistics:
     params:
         config=keys("refine.hub_min_size_ratio", "refine.chain_min_length", "refine.chain_size_ratio",
                     "refine.chain_collinearity"),
+        io=stage_io("shard_statistics"),
     log:
         "logs/shard_statistics/{corpus}-{shard}.log",
     benchmark:
@@ -19,8 +20,7 @@ rule shard_statistics:
     conda:
         ENV
     shell:
-        "planit shard-stats --config-json {params.config:q} --nodes {input.nodes} --edges {input.edges} "
-        "--out-counts {output.counts} --out-candidates {output.candidates} 2> {log}"
+        STAGE
 
 
 rule graph_statistics:
@@ -31,8 +31,7 @@ rule graph_statistics:
         **{name: STATS.replace("{name}", name) for name in STAT_TABLES},
     params:
         config=keys("refine.hub_min_pattern_count"),
-        partial=repeat("--partial", "partial"),
-        nodes=repeat("--nodes", "nodes"),
+        io=stage_io("graph_statistics"),
     log:
         "logs/graph_statistics/{corpus}.log",
     benchmark:
@@ -40,9 +39,7 @@ rule graph_statistics:
     conda:
         ENV
     shell:
-        "planit graph-stats --config-json {params.config:q} {params.partial} {params.nodes} "
-        "--out-cooccurrence {output.cooccurrence} --out-relations {output.relations} "
-        "--out-hub-patterns {output.hub_patterns} --out-category-sizes {output.category_sizes} 2> {log}"
+        STAGE
 
 
 rule refine_graphs:
@@ -60,6 +57,7 @@ rule refine_graphs:
         summary=FINAL_SUMMARY,
     params:
         config=keys("refine.pruning", "refine.thresholds", "refine.connectivity"),
+        io=stage_io("refine_graphs"),
     log:
         "logs/refine_graphs/{corpus}-{shard}.log",
     benchmark:
@@ -67,10 +65,7 @@ rule refine_graphs:
     conda:
         ENV
     shell:
-        "planit refine --shard {wildcards.shard} --config-json {params.config:q} --nodes {input.nodes} "
-        "--edges {input.edges} --candidates {input.candidates} --relations {input.relations} "
-        "--hub-patterns {input.hub_patterns} --category-sizes {input.category_sizes} --out-nodes {output.nodes} "
-        "--out-edges {output.edges} --out-superstructures {output.superstructures} --out-summary {output.summary} 2> {log}"
+        STAGE
 
 
 rule gather_graphs:
@@ -83,9 +78,8 @@ rule gather_graphs:
         edges=GATHERED.replace("{table}", "edges"),
         superstructures=GATHERED.replace("{table}", "superstructures"),
     params:
-        nodes=repeat("--nodes", "nodes"),
-        edges=repeat("--edges", "edges"),
-        superstructures=repeat("--superstructures", "superstructures"),
+        config=keys(),
+        io=stage_io("gather_graphs"),
     log:
         "logs/gather_graphs/{corpus}.log",
     benchmark:
@@ -93,8 +87,7 @@ rule gather_graphs:
     conda:
         ENV
     shell:
-        "planit gather-graphs {params.nodes} {params.edges} {params.superstructures} --out-nodes {output.nodes} "
-        "--out-edges {output.edges} --out-superstructures {output.superstructures} 2> {log}"
+        STAGE
 
 
 rule score_superstructures:
@@ -105,7 +98,8 @@ rule score_superstructures:
     output:
         metrics=METRICS.replace("{name}", "superstructures"),
     params:
-        ground_truth=repeat("--ground-truth", "ground_truth"),
+        config=keys(),
+        io=stage_io("score_superstructures"),
     log:
         "logs/score_superstructures/{corpus}.log",
     benchmark:
@@ -113,8 +107,7 @@ rule score_superstructures:
     conda:
         ENV
     shell:
-        "planit score-graphs --nodes {input.nodes} --superstructures {input.superstructures} {params.ground_truth} "
-        "--out {output.metrics} > {log} 2>&1"
+        STAGE
 
 
 rule graph_report:
@@ -130,6 +123,9 @@ rule graph_report:
         relations=REPORT.replace("{name}", "relations.csv"),
         plot=report(REPORT.replace("{name}", "graph_stats.png"), caption="../report/graph_stats.rst", category="2. Graphs",
                     labels={"corpus": "{corpus}", "figure": "edges per node"}),
+    params:
+        config=keys(),
+        io=stage_io("graph_report"),
     log:
         "logs/graph_report/{corpus}.log",
     benchmark:
@@ -137,6 +133,4 @@ rule graph_report:
     conda:
         ENV
     shell:
-        "planit graph-report --nodes {input.nodes} --edges {input.edges} --superstructures {input.superstructures} "
-        "--out-table1 {output.table1} --out-pruning {output.pruning} --out-relations {output.relations} "
-        "--out-plot {output.plot} 2> {log}"
+        STAGE

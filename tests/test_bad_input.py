@@ -15,6 +15,7 @@ import pyarrow.parquet as pq
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
+from pipeline.stage import Files
 from pipeline import config, tables
 from pipeline.stages import ingest, ingest_summary
 from pipeline.errors import InputError
@@ -34,7 +35,7 @@ def run(tmp: Path, houses: dict[str, object], future: Path = FIX / "future", **s
     cfg = config.validate({"source": "front3d", "shards": 1,
                            "front3d": {"houses": str(folder), "future": str(future), "cache_dir": None, **section}})
     outs = {n: tmp / "out" / f"{n}.parquet" for n in ingest.OUTPUTS}
-    ingest.run(cfg, 0, outs)
+    ingest.run(cfg, Files(), Files(outs), shard=0)
     return {n: pd.read_parquet(p) for n, p in outs.items()}
 
 
@@ -80,9 +81,10 @@ def test_same_house_uid_in_two_files_and_repeated_ids_stay_unique(tmp_path):
     assert dup[dup.reason.str.startswith("duplicate furniture uid")].field.tolist() == ["furniture[4].uid"]
     out = tmp_path / "out"
     summary = tmp_path / "summary"
-    ingest_summary.run([out / "rooms.parquet"], [out / "objects.parquet"], [out / "models.parquet"],
-                       [out / "ingest_report.parquet"], [out / "drops.parquet"], summary / "c.parquet",
-                       summary / "r.parquet", summary / "d.parquet")
+    ingest_summary.run({}, Files(rooms=[out / "rooms.parquet"], objects=[out / "objects.parquet"],
+                                 models=[out / "models.parquet"], reports=[out / "ingest_report.parquet"],
+                                 drops=[out / "drops.parquet"]),
+                       Files(counts=summary / "c.parquet", report=summary / "r.parquet", drops=summary / "d.parquet"))
     rep = pd.read_parquet(summary / "r.parquet")
     twins = rep[rep.status == "duplicate uid"]
     assert twins.item.tolist() == [BASE["uid"]] and twins["count"].tolist() == [2] and "a.json" in twins.reason.iloc[0]
@@ -178,10 +180,11 @@ def test_no_room_at_all_is_a_clear_error_at_ingest(tmp_path):
     t = tmp_path / "i"
     cfg = config.validate({"source": "front3d", "shards": 1, "front3d": {"houses": str(tmp_path), "future": str(FIX / "future")}})
     outs = {n: t / f"{n}.parquet" for n in ingest.OUTPUTS}
-    ingest.run(cfg, 0, outs)  # an empty shard is fine ...
+    ingest.run(cfg, Files(), Files(outs), shard=0)  # an empty shard is fine ...
     with pytest.raises(InputError, match="no room was ingested"):  # ... an empty corpus is not
-        ingest_summary.run([outs["rooms"]], [outs["objects"]], [outs["models"]], [outs["ingest_report"]],
-                           [outs["drops"]], t / "c.parquet", t / "r.parquet", t / "d.parquet")
+        ingest_summary.run({}, Files(rooms=[outs["rooms"]], objects=[outs["objects"]], models=[outs["models"]],
+                                     reports=[outs["ingest_report"]], drops=[outs["drops"]]),
+                           Files(counts=t / "c.parquet", report=t / "r.parquet", drops=t / "d.parquet"))
 
 
 def test_tables_refuse_non_finite_numbers_and_duplicate_ids(tmp_path):
@@ -198,7 +201,7 @@ def test_tables_refuse_non_finite_numbers_and_duplicate_ids(tmp_path):
 def test_corrupt_intermediate_table_names_the_file_and_its_rule(tmp_path):
     junk = tmp_path / "edges-0.parquet"
     junk.write_bytes(b"PAR1 garbage")
-    out = subprocess.run([PLANIT, "shard-stats", "--nodes", str(junk), "--edges", str(junk), "--out-counts",
+    out = subprocess.run([PLANIT, "shard_statistics", "--nodes", str(junk), "--edges", str(junk), "--out-counts",
                           str(tmp_path / "c.parquet"), "--out-candidates", str(tmp_path / "k.parquet")],
                          capture_output=True, text=True, timeout=120)
     errors = [line for line in out.stderr.splitlines() if line.startswith("error:")]
@@ -311,7 +314,7 @@ def test_real_sample_houses_ingest_with_every_drop_named(tmp_path):
     cfg = config.validate({"source": "front3d", "shards": 1, "front3d": {
         "houses": str(sample / "houses"), "future": str(sample / "3d-future"), "cache_dir": str(tmp_path / "c")}})
     outs = {n: tmp_path / f"{n}.parquet" for n in ingest.OUTPUTS}
-    ingest.run(cfg, 0, outs)
+    ingest.run(cfg, Files(), Files(outs), shard=0)
     rooms, objs = pd.read_parquet(outs["rooms"]), pd.read_parquet(outs["objects"])
     drops = pd.read_parquet(outs["drops"])
     assert rooms.room_id.is_unique and not drops.empty and drops.file.notna().all() and drops.reason.notna().all()

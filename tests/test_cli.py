@@ -36,7 +36,7 @@ def test_stats_on_bad_input_names_the_file(tmp_path):
 
 def test_stage_with_missing_input_fails_cleanly(tmp_path):
     f = tmp_path / "f"
-    out = planit("filter", "--rooms", str(tmp_path / "nowhere/rooms-0.parquet"), "--architecture", "a", "--objects", "o", "--models", "m",
+    out = planit("filter_rooms", "--rooms", str(tmp_path / "nowhere/rooms-0.parquet"), "--architecture", "a", "--objects", "o", "--models", "m",
                  "--counts", "c", "--out-rooms", str(f / "rooms.parquet"), "--out-report", str(f / "report.parquet"))
     assert out.returncode == 2 and "nowhere/rooms-0.parquet" in out.stderr and "Traceback" not in out.stderr
     assert len(out.stderr.strip().splitlines()) <= 2  # the log line and the error line
@@ -45,7 +45,7 @@ def test_stage_with_missing_input_fails_cleanly(tmp_path):
 
 def test_stage_with_malformed_input_names_the_field(tmp_path):
     pq.write_table(pa.table({"room_id": ["r1"]}), tmp_path / "rooms.parquet")
-    out = planit("filter", "--rooms", str(tmp_path / "rooms.parquet"), "--architecture", "a", "--objects", "o", "--models", "m",
+    out = planit("filter_rooms", "--rooms", str(tmp_path / "rooms.parquet"), "--architecture", "a", "--objects", "o", "--models", "m",
                  "--counts", "c", "--out-rooms", str(tmp_path / "k.parquet"), "--out-report", str(tmp_path / "r.parquet"))
     assert out.returncode == 2 and "rooms.parquet" in out.stderr and "source" in out.stderr
 
@@ -55,7 +55,7 @@ def test_corrupt_intermediate_table_is_one_line_naming_it(tmp_path):
     junk.write_bytes(b"PAR1 not really")
     outs = [f"--out-{n}" for n in ("cooccurrence", "relations", "hub-patterns", "category-sizes")]
     args = [a for o in outs for a in (o, str(tmp_path / f"{o}.parquet"))]
-    out = planit("graph-stats", "--partial", str(junk), "--nodes", str(junk), *args)
+    out = planit("graph_statistics", "--partial", str(junk), "--nodes", str(junk), *args)
     assert out.returncode == 2 and "partial-0.parquet" in out.stderr and "Traceback" not in out.stderr
 
 
@@ -64,7 +64,7 @@ def test_invalid_config_file_names_the_key_in_one_line(tmp_path):
     cfg.write_text("procedural:\n  defect_rate: 2\n")
     o = tmp_path / "i"
     out = planit("ingest", "--shard", "0", "--config", str(cfg), *[a for n in ("rooms", "architecture", "objects", "models",
-                 "ground-truth", "report", "drops") for a in (f"--{n}", str(o / f"{n}.parquet"))])
+                 "ground-truth", "ingest-report", "drops") for a in (f"--out-{n}", str(o / f"{n}.parquet"))])
     assert out.returncode == 2 and "procedural.defect_rate" in out.stderr
     assert [line for line in out.stderr.splitlines() if line.startswith("error:")] == [
         f"error: {cfg}: invalid config at key 'procedural.defect_rate': 2 is greater than the maximum of 1"]
@@ -73,8 +73,8 @@ def test_invalid_config_file_names_the_key_in_one_line(tmp_path):
 def test_missing_source_folder_is_a_clear_error(tmp_path):
     o = tmp_path / "i"
     out = planit("ingest", "--shard", "0", "--config-json", '{"source": "front3d", "front3d": {"houses": "/nowhere"}}',
-                 *[a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report", "drops")
-                   for a in (f"--{n}", str(o / f"{n}.parquet"))])
+                 *[a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "ingest-report", "drops")
+                   for a in (f"--out-{n}", str(o / f"{n}.parquet"))])
     assert out.returncode == 2 and "front3d" in out.stderr and "/nowhere" in out.stderr and "Traceback" not in out.stderr
 
 
@@ -95,8 +95,8 @@ def test_only_domain_errors_are_turned_into_one_line():
 def test_strict_keys_expose_a_rule_that_forgets_a_key(tmp_path):
     # the rules run stages with PLANIT_STRICT_KEYS=1: a stage reading a key its rule did not pass fails loudly
     o = tmp_path / "i"
-    args = [a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report", "drops")
-            for a in (f"--{n}", str(o / f"{n}.parquet"))]
+    args = [a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "ingest-report", "drops")
+            for a in (f"--out-{n}", str(o / f"{n}.parquet"))]
     env = {**os.environ, "PLANIT_STRICT_KEYS": "1"}
     out = subprocess.run([PLANIT, "ingest", "--shard", "0", "--config-json", '{"source": "procedural"}', *args],
                          capture_output=True, text=True, env=env, timeout=300)

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from pipeline.stage import Files
 from pipeline import config
 from pipeline.filtering import category_room_counts, filter_rooms
 from pipeline.geometry import collision, meshes
@@ -113,10 +114,9 @@ def test_real_furniture_meshes_overlap_far_less_than_their_boxes(tmp_path):
 
     cfg = config.validate({"source": "front3d", "shards": 1})
     ing = tmp_path / "ingest"
-    symmetry.run(cfg, [ing / "models-0.parquet"], tmp_path / "sym.parquet", tmp_path / "sym.json")
-    extract_graphs.run(cfg, 0, ing / "rooms-0.parquet", ing / "architecture-0.parquet", ing / "objects-0.parquet",
-                       ing / "models-0.parquet", tmp_path / "sym.parquet", tmp_path / "n.parquet", tmp_path / "e.parquet",
-                       tmp_path / "s.json")
+    symmetry.run(cfg, Files(models=[ing / "models-0.parquet"]), Files(table=tmp_path / "sym.parquet", agreement=tmp_path / "sym.json"))
+    extract_graphs.run(cfg, Files(rooms=ing / "rooms-0.parquet", architecture=ing / "architecture-0.parquet", objects=ing / "objects-0.parquet", models=ing / "models-0.parquet", symmetry=tmp_path / "sym.parquet"),
+                       Files(nodes=tmp_path / "n.parquet", edges=tmp_path / "e.parquet", summary=tmp_path / "s.json"), shard=0)
     nodes = pd.read_parquet(tmp_path / "n.parquet")
     edges = pd.read_parquet(tmp_path / "e.parquet")
     assert len(nodes[nodes.kind == "object"]) >= 100

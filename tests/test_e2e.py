@@ -11,6 +11,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
+from pipeline.stage import Files
 from pipeline import tables
 from pipeline.learning import checkpoint
 from conftest import ROOT
@@ -224,9 +225,8 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
     gen = res / "generated" / "bedroom" / "planit"
     placed = pd.read_parquet(gen / "scenes.parquet").placed_objects.sum()
     cfg = config_mod.validate({"seed": 7})
-    extract_graphs.run(cfg, 0, gen / "rooms.parquet", gen / "architecture.parquet", gen / "objects.parquet",
-                       gen / "models.parquet", res / "graphs/ingested/symmetry.parquet", tmp_path / "n.parquet",
-                       tmp_path / "e.parquet", tmp_path / "s.json")
+    extract_graphs.run(cfg, Files(rooms=gen / "rooms.parquet", architecture=gen / "architecture.parquet", objects=gen / "objects.parquet", models=gen / "models.parquet", symmetry=res / "graphs/ingested/symmetry.parquet"),
+                       Files(nodes=tmp_path / "n.parquet", edges=tmp_path / "e.parquet", summary=tmp_path / "s.json"), shard=0)
     nodes = pd.read_parquet(tmp_path / "n.parquet")
     assert (nodes.kind == "object").sum() == placed
 

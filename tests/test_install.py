@@ -53,8 +53,8 @@ def test_wheel_installs_and_runs_without_the_source_tree(tmp_path):
     where = subprocess.run([str(py), "-c", "import pipeline; print(pipeline.__file__)"], cwd=work, capture_output=True,
                            text=True, check=True).stdout.strip()
     assert where.startswith(str(site)), where
-    outs = [a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "report", "drops")
-            for a in (f"--{n}", str(work / f"{n}.parquet"))]
+    outs = [a for n in ("rooms", "architecture", "objects", "models", "ground-truth", "ingest-report", "drops")
+            for a in (f"--out-{n}", str(work / f"{n}.parquet"))]
     cfg = '{"shards": 1, "procedural": {"rooms": {"bedroom": 2, "living": 1, "office": 0, "bathroom": 1, "kitchen": 0}}}'
     out = subprocess.run([str(py), "-m", "pipeline", "ingest", "--shard", "0", "--config-json", cfg, *outs], cwd=work,
                          capture_output=True, text=True, timeout=300)

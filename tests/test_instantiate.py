@@ -9,6 +9,7 @@ import pytest
 import trimesh
 
 from conftest import Room, default_config
+from pipeline.stage import Files
 from pipeline.geometry.boxes import footprint_corners
 from pipeline.geometry.frames import Frame, equivalent_frames, side_in, to_local, to_world
 from pipeline.geometry.polygon import outside_area
@@ -294,9 +295,9 @@ def test_real_3d_front_rooms_are_placed_again_from_their_own_graphs(tmp_path):
     # the backtrack budget, not the clock, ends a search here: the outcome must not depend on the machine's load
     cfg = config_mod.validate({"source": "front3d", "shards": 1, "instantiate": {"time_budget": 600}})
     outs = ingest_outputs(tmp_path / "ingest")
-    symmetry.run(cfg, [outs["models"]], tmp_path / "sym.parquet", tmp_path / "sym.json")
-    extract_graphs.run(cfg, 0, outs["rooms"], outs["architecture"], outs["objects"], outs["models"], tmp_path / "sym.parquet",
-                       tmp_path / "n.parquet", tmp_path / "e.parquet", tmp_path / "s.json")
+    symmetry.run(cfg, Files(models=[outs["models"]]), Files(table=tmp_path / "sym.parquet", agreement=tmp_path / "sym.json"))
+    extract_graphs.run(cfg, Files(rooms=outs["rooms"], architecture=outs["architecture"], objects=outs["objects"], models=outs["models"], symmetry=tmp_path / "sym.parquet"),
+                       Files(nodes=tmp_path / "n.parquet", edges=tmp_path / "e.parquet", summary=tmp_path / "s.json"), shard=0)
     plans = [p for p in own_plans(pd.read_parquet(tmp_path / "n.parquet"), pd.read_parquet(tmp_path / "e.parquet"))
              if 3 <= len(p.ids) <= 8]
     assert len(plans) >= 3

@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from pipeline.stage import Files
 from pipeline.corpus import catalog, procedural
 
 
@@ -98,12 +99,12 @@ def test_hard_placements_are_recovered_per_case(tmp_path):
         "rooms": {"bedroom": 25, "living": 25, "office": 25, "bathroom": 10, "kitchen": 15}, "defect_rate": 0.0,
         "placement": {"flush": 0.35, "overlap": 0.35, "turned": 1.0}}})
     t = {name: tmp_path / f"{name}.parquet" for name in ingest.OUTPUTS}
-    ingest.run(cfg, 0, t)
-    symmetry.run(cfg, [t["models"]], tmp_path / "symmetry.parquet", tmp_path / "agreement.json")
-    extract_graphs.run(cfg, 0, t["rooms"], t["architecture"], t["objects"], t["models"], tmp_path / "symmetry.parquet",
-                       tmp_path / "nodes.parquet", tmp_path / "edges.parquet", tmp_path / "summary.json")
-    scores = score_extraction.run([tmp_path / "nodes.parquet"], [tmp_path / "edges.parquet"], [t["ground_truth"]],
-                                  tmp_path / "scores.json")
+    ingest.run(cfg, Files(), Files(t), shard=0)
+    symmetry.run(cfg, Files(models=[t["models"]]), Files(table=tmp_path / "symmetry.parquet", agreement=tmp_path / "agreement.json"))
+    extract_graphs.run(cfg, Files(rooms=t["rooms"], architecture=t["architecture"], objects=t["objects"], models=t["models"], symmetry=tmp_path / "symmetry.parquet"),
+                       Files(nodes=tmp_path / "nodes.parquet", edges=tmp_path / "edges.parquet", summary=tmp_path / "summary.json"), shard=0)
+    scores = score_extraction.run(cfg, Files(nodes=[tmp_path / "nodes.parquet"], edges=[tmp_path / "edges.parquet"],
+                                             ground_truth=[t["ground_truth"]]), Files(metrics=tmp_path / "scores.json"))
     by_case = scores["adjacent_recall_by_case"]
     assert set(by_case) == {"gap", "flush", "overlap", "turned"}
     for case, s in by_case.items():

@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 import shapely
 
+from pipeline.stage import Files
 from pipeline import config
 from pipeline.corpus import front3d
 from pipeline.errors import InputError
@@ -28,7 +29,7 @@ def run_ingest(source: str, section: dict, tmp_path) -> dict[str, pd.DataFrame]:
     """One ingest job over the whole source (a single shard)."""
     cfg = config.validate({"source": source, source: section, "shards": 1})
     outs = ingest_outputs(tmp_path / "ingest")
-    ingest.run(cfg, 0, outs)
+    ingest.run(cfg, Files(), Files(outs), shard=0)
     return {name: pd.read_parquet(path) for name, path in outs.items()}
 
 
@@ -178,17 +179,20 @@ def test_ithor_real_rooms_support_parents_agree(tmp_path):
     cfg = config.load(ROOT / "config/ithor.yaml", json.dumps({"shards": 1, "extract": {"symmetry": {"detect": False}}}))
     t = tmp_path
     outs = ingest_outputs(t)
-    ingest.run(cfg, 0, outs)
+    ingest.run(cfg, Files(), Files(outs), shard=0)
     rooms = pd.read_parquet(outs["rooms"])
     assert len(rooms) == 120 and Counter(rooms.room_type) == {"bedroom": 30, "living": 30, "kitchen": 30, "bathroom": 30}
-    ingest_summary.run([outs["rooms"]], [outs["objects"]], [outs["models"]], [outs["ingest_report"]], [outs["drops"]],
-                       t / "counts.parquet", t / "rep.parquet", t / "drops.parquet")
-    filter_rooms.run(cfg, outs["rooms"], outs["architecture"], outs["objects"], outs["models"], t / "counts.parquet", t / "kept.parquet",
-                     t / "filter.parquet")
-    symmetry.run(cfg, [outs["models"]], t / "sym.parquet", t / "sym.json")
-    extract_graphs.run(cfg, 0, t / "kept.parquet", outs["architecture"], outs["objects"], outs["models"], t / "sym.parquet",
-                       t / "nodes.parquet", t / "edges.parquet", t / "summary.json")
-    metrics = score_extraction.run([t / "nodes.parquet"], [t / "edges.parquet"], [outs["ground_truth"]], t / "m.json")
+    ingest_summary.run(cfg, Files(rooms=[outs["rooms"]], objects=[outs["objects"]], models=[outs["models"]],
+                                  reports=[outs["ingest_report"]], drops=[outs["drops"]]),
+                       Files(counts=t / "counts.parquet", report=t / "rep.parquet", drops=t / "drops.parquet"))
+    filter_rooms.run(cfg, Files(rooms=outs["rooms"], architecture=outs["architecture"], objects=outs["objects"],
+                                models=outs["models"], counts=t / "counts.parquet"),
+                     Files(rooms=t / "kept.parquet", report=t / "filter.parquet"))
+    symmetry.run(cfg, Files(models=[outs["models"]]), Files(table=t / "sym.parquet", agreement=t / "sym.json"))
+    extract_graphs.run(cfg, Files(rooms=t / "kept.parquet", architecture=outs["architecture"], objects=outs["objects"], models=outs["models"], symmetry=t / "sym.parquet"),
+                       Files(nodes=t / "nodes.parquet", edges=t / "edges.parquet", summary=t / "summary.json"), shard=0)
+    metrics = score_extraction.run(cfg, Files(nodes=[t / "nodes.parquet"], edges=[t / "edges.parquet"],
+                                              ground_truth=[outs["ground_truth"]]), Files(metrics=t / "m.json"))
     assert metrics["supported_objects"] > 1500
     assert metrics["support_parent_recall"] >= 0.965  # measured 0.9682 (goal 0.98: docs/real-data.md)
 

@@ -53,7 +53,7 @@ def graph_report(nodes: Path, edges: Path, superstructures: Path) -> dict[str, p
                           CAST(status AS VARCHAR) status, count(*) edges
                    FROM edges WHERE origin = 'raw' AND edge_type NOT IN {ARCH} GROUP BY 1, 2, 3)
         SELECT *, edges / sum(edges) OVER (PARTITION BY room_type) share_of_raw FROM c
-        ORDER BY room_type, edges DESC""").df()
+        ORDER BY room_type, edges DESC, rule, status""").df()
     relations = con.execute("""
         WITH c AS (
           SELECT CAST(e.room_type AS VARCHAR) room_type, CAST(a.category AS VARCHAR) anchor,
@@ -62,8 +62,9 @@ def graph_report(nodes: Path, edges: Path, superstructures: Path) -> dict[str, p
           FROM edges e JOIN nodes a ON a.room_id = e.room_id AND a.node_id = e.source
                        JOIN nodes b ON b.room_id = e.room_id AND b.node_id = e.target
           WHERE e.status = 'kept' AND b.kind = 'object' GROUP BY 1, 2, 3, 4, 5, 6)
-        SELECT * FROM c QUALIFY row_number() OVER (PARTITION BY room_type ORDER BY edges DESC, anchor, target) <= 10
-        ORDER BY room_type, edges DESC""").df()
+        SELECT * FROM c QUALIFY row_number() OVER (PARTITION BY room_type ORDER BY edges DESC, anchor, target, edge_type,
+                                                   direction, distance) <= 10
+        ORDER BY room_type, edges DESC, anchor, target, edge_type, direction, distance""").df()
     return {"table1": table1, "pruning": pruning, "relations": relations}
 
 

@@ -12,6 +12,7 @@ import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import torch
 
 from .. import tables
@@ -31,7 +32,7 @@ class Checkpoint:
 def save(path: Path, ckpt: Checkpoint) -> Path:
     """Write ``ckpt`` atomically to ``path``."""
     payload = {"format": FORMAT, "kind": ckpt.kind, "config_hash": ckpt.config_hash, "state": ckpt.state,
-               "record": json.dumps(ckpt.record)}
+               "record": json.dumps(ckpt.record, default=_plain)}
     return tables.write_atomic(path, lambda tmp: torch.save(payload, tmp))
 
 
@@ -57,6 +58,13 @@ def resume(path: Path, kind: str, config_hash: str, device: str = "cpu") -> Chec
         return load(path, kind, config_hash, device)
     except InputError:
         return None
+
+
+def _plain(value):
+    """NumPy scalars and arrays in a record as plain JSON values."""
+    if isinstance(value, (np.generic, np.ndarray)):
+        return value.tolist()
+    raise TypeError(f"a checkpoint record holds a {type(value).__name__}, which is not JSON")
 
 
 def _read(path: Path, device: str) -> Checkpoint:

@@ -1,1 +1,91 @@
-"""Stage wrappers: read canonical tables, call the pure functions, write tables atomically. One module per stage."""
+"""The stages, declared once: each one's files and parameters (``pipeline.stage``). A stage module of the same name
+reads its files, calls one function of the domain packages and writes its files; the ``planit`` subcommand and the
+Snakemake rule of the same name are derived from (and checked against) these declarations. Stage modules do not
+import each other."""
+from __future__ import annotations
+
+from ..stage import Param, Stage, many, one
+
+SHARD = Param("shard", int, help="shard index")
+ROOM_TYPE = Param("room_type", help="room type")
+METHOD = Param("method", help="a generation method (generation.methods)")
+CORPUS = (one("rooms", "the shard's rooms"), one("architecture"), one("objects"), one("models"))
+CORPUS_SHARDS = (many("rooms", "the kept rooms, one per shard"), many("architecture"), many("objects"), many("models"))
+GRAPHS = (one("nodes", "final nodes"), one("edges", "final edges"))
+TRAINING = (one("model", "the trained model"), one("history", "loss per epoch or step (CSV)"),
+            one("curve", "loss curves (PNG)"), one("summary", "training summary (JSON)"))
+GENERATED = (one("rooms"), one("architecture"), one("objects"), one("models"),
+             one("scenes", "one record per scene, failed ones with their reason"), one("summary", "JSON"),
+             one("files", "folder of a GLB, PNG and JSON per scene"))
+
+_ALL = [
+    Stage("ingest", "Read one shard of the configured source into canonical tables.",
+          outputs=(one("rooms"), one("architecture"), one("objects"), one("models"), one("ground_truth"),
+                   one("ingest_report", "the shard's ingest report"),
+                   one("drops", "one row per dropped house, room, object or model")), params=(SHARD,)),
+    Stage("ingest_summary", "Gather the ingest shards: category counts for the filter, the summed ingest report, "
+          "every drop.", inputs=(many("rooms"), many("objects"), many("models"), many("reports"), many("drops")),
+          outputs=(one("counts"), one("report"), one("drops"))),
+    Stage("filter_rooms", "Filter one shard's rooms (every rejection has a reason; interpenetration measured on the "
+          "meshes).", inputs=(*CORPUS, one("counts", "category_counts.parquet")), outputs=(one("rooms"), one("report"))),
+    Stage("filter_report", "Gather the filter reports; print rooms per room type and outcome.",
+          inputs=(many("reports"),), outputs=(one("report"), one("counts", "rule_counts.tsv"))),
+    Stage("symmetry", "Assign a functional symmetry type to every model (config table, else detected from the mesh).",
+          inputs=(many("models"),), outputs=(one("table"), one("agreement"))),
+    Stage("extract_graphs", "Ray-cast one shard's rooms into raw relation graphs (nodes, edges).",
+          inputs=(*CORPUS, one("symmetry")), outputs=(one("nodes"), one("edges"), one("summary")), params=(SHARD,)),
+    Stage("score_extraction", "Score raw graphs against the corpus's ground truth (support parents, intended "
+          "adjacencies).", inputs=(many("nodes"), many("edges"), many("ground_truth")), outputs=(one("metrics"),)),
+    Stage("shard_statistics", "One shard's partial counts and superstructure candidates (the map step of the "
+          "statistics).", inputs=(one("nodes"), one("edges")), outputs=(one("counts"), one("candidates"))),
+    Stage("graph_statistics", "Dataset-wide statistics: the shards' partial counts summed, hub patterns accepted, "
+          "category sizes.", inputs=(many("partial"), many("nodes")),
+          outputs=(one("cooccurrence"), one("relations"), one("hub_patterns"), one("category_sizes"))),
+    Stage("refine_graphs", "Superstructures, pruning and connectivity repair for one shard's raw graphs.",
+          inputs=(one("nodes"), one("edges"), one("candidates"), one("relations"), one("hub_patterns"),
+                  one("category_sizes")),
+          outputs=(one("nodes"), one("edges"), one("superstructures"), one("summary")), params=(SHARD,)),
+    Stage("gather_graphs", "Concatenate the refined shards into one nodes, edges and superstructures table.",
+          inputs=(many("nodes"), many("edges"), many("superstructures")),
+          outputs=(one("nodes"), one("edges"), one("superstructures"))),
+    Stage("score_superstructures", "Hub and chain precision / recall against the corpus's ground truth.",
+          inputs=(one("nodes"), one("superstructures"), many("ground_truth")), outputs=(one("metrics"),)),
+    Stage("graph_report", "Write the graph report: Table 1, pruning by rule, frequent relations (CSV) and a PNG.",
+          inputs=(one("nodes"), one("edges"), one("superstructures")),
+          outputs=(one("table1"), one("pruning"), one("relations"), one("plot"))),
+    Stage("train_graph_model", "Train the graph generative model of one room type (resumes from the checkpoint "
+          "beside --out-model).", inputs=GRAPHS, outputs=TRAINING, params=(ROOM_TYPE,), threads=True),
+    Stage("sample_graphs", "Sample relation graphs of a room type, from scratch or completing --spec.",
+          inputs=(one("model", "the graph model"), *GRAPHS, one("spec", "complete this partial graph (YAML)", True)),
+          outputs=(one("nodes"), one("edges"), one("summary")),
+          params=(ROOM_TYPE, Param("count", int, None, "graphs (default graph_model.sample.graphs)")), threads=True),
+    Stage("graph_model_metrics", "Evaluate a room type's graph model (held-out NLL; generated vs held-out graphs "
+          "beside the sampling floor).", inputs=(one("model"), *GRAPHS, one("gen_nodes"), one("gen_edges"),
+                                                 one("sample_summary")),
+          outputs=(one("metrics"),), params=(ROOM_TYPE,)),
+    Stage("train_placement", "Train the location and orientation networks of one room type (resumes from the "
+          "checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS), outputs=TRAINING,
+          params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned) or fcn (the unconditional ablation)")),
+          threads=True),
+    Stage("instantiate", "Place graphs of one room type into rooms: canonical tables, a record per scene, GLB / PNG "
+          "/ JSON per scene.", inputs=(one("nodes", "graphs: generated (sampled) or final nodes"), one("edges"),
+                                       one("model", "placement networks"), *CORPUS_SHARDS, one("symmetry"),
+                                       one("category_sizes")),
+          outputs=GENERATED, params=(ROOM_TYPE, Param("variant", help="a key of instantiate.variants"),
+                                     Param("count", int, None, "scenes (default from instantiate)")), threads=True),
+    Stage("table3", "Gather the variants' summaries of one room type into PlanIT's Table 3 (CSV).",
+          inputs=(many("summaries", "one per variant"),), outputs=(one("table"),)),
+    Stage("evaluate", "Score generated rooms, baselines and held-out real rooms of one room type with the same "
+          "metrics.", inputs=(many("summaries", "one per generated set (its name: the summary's method)"),
+                              many("generated_rooms"), many("generated_architecture"), many("generated_objects"),
+                              many("generated_scenes"), many("generated_files", "each set's scene files (gallery)"),
+                              *CORPUS_SHARDS, *GRAPHS, one("symmetry")),
+          outputs=(one("metrics"), one("scenes"), one("table", "the sets side by side (CSV)"),
+                   one("gallery", "folder of generated and real rooms (PNG, GLB)")), params=(ROOM_TYPE,),
+          threads=True),
+    Stage("runtime", "Job seconds and peak memory per rule from the benchmark files, and the run's wall-clock span.",
+          inputs=(many("done", "the outputs whose jobs are timed (read for their presence only)"),),
+          outputs=(one("table", "runtime.csv"),),
+          params=(Param("benchmarks", str, "benchmarks", "Snakemake's benchmark folder"),)),
+]
+STAGES: dict[str, Stage] = {s.module: s for s in _ALL}

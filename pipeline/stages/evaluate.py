@@ -6,6 +6,7 @@ retrieval baseline (each generated scene's nearest training room) and the held-o
 ceiling). Every set goes through the same functions."""
 from __future__ import annotations
 
+import json
 import logging
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +23,7 @@ from ..log import progress
 from ..placement.checks import Checker
 from ..placement.search import SCORED
 from ..room import RoomInput, room_inputs
+from ..stage import Files
 
 log = logging.getLogger("planit.evaluate")
 REAL, RETRIEVAL = "real_heldout", "retrieval"
@@ -45,14 +47,13 @@ def room_set(name: str, rooms: pd.DataFrame, architecture: pd.DataFrame, objects
     return RoomSet(name, inputs, [parents.get(r.room_id, []) for r in inputs], scenes, len(rooms))
 
 
-def load_generated(name: str, folder: Path) -> RoomSet:
-    """A variant's placed scenes, partial ones included (failed ones are counted, not scored)."""
-    read = lambda t, schema: tables.read(folder / f"{t}.parquet", schema).to_pandas()
-    scenes = read("scenes", "scenes")
+def load_generated(name: str, rooms: Path, architecture: Path, objects: Path, scenes: Path) -> RoomSet:
+    """A generated set's placed scenes, partial ones included (failed ones are counted, not scored)."""
+    scenes = tables.read(scenes, "scenes").to_pandas()
     placed = set(scenes.loc[scenes["status"].astype(str).isin(SCORED), "scene_id"])
-    rooms = read("rooms", "rooms")
-    out = room_set(name, rooms[rooms["room_id"].isin(placed)], read("architecture", "architecture"),
-                   read("objects", "generated_objects"), scenes[scenes["scene_id"].isin(placed)])
+    rooms = tables.read(rooms, "rooms").to_pandas()
+    out = room_set(name, rooms[rooms["room_id"].isin(placed)], tables.read(architecture, "architecture").to_pandas(),
+                   tables.read(objects, "generated_objects").to_pandas(), scenes[scenes["scene_id"].isin(placed)])
     out.attempted = len(scenes)
     return out
 
@@ -208,16 +209,21 @@ def label_maps(rs: RoomSet, index: dict, cfg: dict) -> np.ndarray:
     return np.stack(maps) if maps else np.zeros((0, size, size), np.int16)
 
 
-def run(config: dict, room_type: str, generated: list[tuple[str, Path]], rooms: list[Path], architecture: list[Path],
-        objects: list[Path], models: list[Path], nodes: Path, edges: Path, symmetry: Path, out_metrics: Path,
-        out_scenes: Path,
-        out_table: Path, out_gallery: Path, threads: int = 1) -> dict:
+def generated_sets(inp: Files) -> list[tuple[str, RoomSet]]:
+    """(name, rooms) of each generated set, in the order given (the default generator first)."""
+    names = [json.loads(Path(s).read_text())["variant"] for s in inp.summaries]
+    return [load_generated(n, r, a, o, s) for n, r, a, o, s in zip(names, inp.generated_rooms, inp.generated_architecture,
+                                                                    inp.generated_objects, inp.generated_scenes)]
+
+
+def run(config: dict, inp: Files, out: Files, room_type: str, threads: int = 1) -> dict:
     """Score every set; write the per-scene rows (``eval_scenes``), ``metrics.json``, the table of the sets beside
     each other (CSV) and a gallery of generated and held-out real rooms with their graphs (PNG, GLB). ``generated``:
     (set name, instantiation folder) pairs, the default variant (planit) first."""
     ev = config["evaluate"]
+    rooms, architecture, objects, models, nodes, edges = inp.rooms, inp.architecture, inp.objects, inp.models, inp.nodes, inp.edges
     train, real = load_real(config, room_type, rooms, architecture, objects, nodes)
-    gen = [load_generated(name, Path(folder)) for name, folder in generated]
+    gen = generated_sets(inp)
     model_ids = {m for rs in (train, real, *gen) for r in rs.rooms for m in r.model_ids}
     meshes, box_models = tables.read_meshes_of(models, model_ids)
     index = {c: k for k, c in enumerate(sorted({c for s in (train, real, *gen) for r in s.rooms for c in r.categories}))}
@@ -238,7 +244,7 @@ def run(config: dict, room_type: str, generated: list[tuple[str, Path]], rooms: 
                                                               render.palette(sorted(index))), sca_settings, threads,
                                      config["seed"])
     if config["source"] == "procedural":  # the generator's own rules: an oracle only for its rooms
-        checker = Checker(meshes, box_models, _symmetry(symmetry), {**config["extract"], "floor_contact":
+        checker = Checker(meshes, box_models, _symmetry(inp.symmetry), {**config["extract"], "floor_contact":
                           config["floor_contact"]}, intersector_class(config["extract"]["backend"]), {})
         for name, rs in by_name.items():
             sets[name]["rules"] = rule_satisfaction(rs, checker)
@@ -249,10 +255,10 @@ def run(config: dict, room_type: str, generated: list[tuple[str, Path]], rooms: 
                        "settings": {k: ev[k] for k in ("render", "walk", "collision", "out_of_bounds", "sca", "kl_eps")},
                        "categories": sorted(index)})
     frame = pd.concat(list(rows.values()), ignore_index=True)
-    tables.write(out_scenes, "eval_scenes", tables.from_rows("eval_scenes", tables.records(frame)))
-    tables.write_csv(out_table, metrics_table(metrics))
-    gallery(out_gallery, gen[0], Path(generated[0][1]), real, nodes, edges, ev["gallery"])
-    tables.write_json(out_metrics, metrics)
+    tables.write(out.scenes, "eval_scenes", tables.from_rows("eval_scenes", tables.records(frame)))
+    tables.write_csv(out.table, metrics_table(metrics))
+    gallery(out.gallery, gen[0], Path(inp.generated_files[0]), real, nodes, edges, ev["gallery"])
+    tables.write_json(out.metrics, metrics)
     return metrics
 
 
@@ -287,7 +293,7 @@ def gallery(folder: Path, gen: RoomSet, gen_folder: Path, real: RoomSet, nodes: 
     tmp.mkdir(parents=True)
     for room in gen.rooms[:count]:
         for ext in ("png", "glb"):
-            src = gen_folder / "scenes" / f"{room.room_id}.{ext}"
+            src = gen_folder / f"{room.room_id}.{ext}"
             if src.exists():
                 shutil.copyfile(src, tmp / f"generated_{room.room_id}.{ext}")
     picked = real.rooms[:count]

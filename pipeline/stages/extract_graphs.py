@@ -5,13 +5,13 @@ import logging
 import time
 from pathlib import Path
 
-
 from .. import tables
 from ..config import config_hash
 from ..extraction import extract_room
 from ..geometry.raycast import intersector_class
 from ..log import progress
 from ..room import room_inputs
+from ..stage import Files
 
 log = logging.getLogger("planit.extract")
 
@@ -27,8 +27,9 @@ def load_shard(rooms: Path, architecture: Path, objects: Path, models: Path):
     return room_df, arch, objs, meshes, box_models
 
 
-def run(config: dict, shard: int, rooms: Path, architecture: Path, objects: Path, models: Path, symmetry: Path,
-        out_nodes: Path, out_edges: Path, out_summary: Path) -> dict:
+def run(config: dict, inp: Files, out: Files, shard: int) -> dict:
+    rooms, architecture, objects, models, symmetry = inp.rooms, inp.architecture, inp.objects, inp.models, inp.symmetry
+    out_nodes, out_edges, out_summary = out.nodes, out.edges, out.summary
     cfg = {**config["extract"], "floor_contact": config["floor_contact"]}
     intersector = intersector_class(cfg["backend"])
     room_df, arch, objs, meshes, box_models = load_shard(rooms, architecture, objects, models)

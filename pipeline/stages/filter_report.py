@@ -8,11 +8,13 @@ import pandas as pd
 
 from .. import tables
 from ..filtering import rule_counts
+from ..stage import Files
 
 log = logging.getLogger("planit.filter")
 
 
-def run(reports: list[Path], out_report: Path, out_counts: Path) -> pd.DataFrame:
+def run(config: dict, inp: Files, out: Files) -> pd.DataFrame:
+    reports, out_report, out_counts = inp.reports, out.report, out.counts
     table = tables.read_many(reports, "filter_report")
     tables.write(out_report, "filter_report", table)
     counts = rule_counts(table.to_pandas())

@@ -10,13 +10,15 @@ from .. import tables
 from ..config import config_hash
 from ..filtering import filter_rooms
 from ..geometry.raycast import intersector_class
+from ..stage import Files
 
 log = logging.getLogger("planit.filter")
 
 
-def run(config: dict, rooms: Path, architecture: Path, objects: Path, models: Path, counts: Path, out_rooms: Path,
-        out_report: Path) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
     """Write the shard's kept rooms (``rooms`` schema) and its filter report."""
+    rooms, architecture, objects, models, counts = inp.rooms, inp.architecture, inp.objects, inp.models, inp.counts
+    out_rooms, out_report = out.rooms, out.report
     room_df = tables.read(rooms, "rooms").to_pandas()
     obj_df = tables.read(objects, "objects").to_pandas()
     meshes, box_models = tables.read_meshes(models, obj_df["model_id"].dropna())

@@ -7,6 +7,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from .. import tables
+from ..stage import Files
 
 SCHEMA_OF = {"nodes": "final_nodes", "edges": "final_edges", "superstructures": "superstructures"}
 
@@ -29,7 +30,7 @@ def _parts(paths: list[Path], schema: str):
                 yield part
 
 
-def run(inputs: dict[str, list[Path]], outputs: dict[str, Path]) -> dict:
+def run(config: dict, inputs: Files, outputs: Files) -> dict:
     """Stream each table's shards into one file, room type by room type (each shard keeps its room order)."""
     counts = {}
     for name, schema in SCHEMA_OF.items():

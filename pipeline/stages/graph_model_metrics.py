@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import tables
+from ..stage import Files
 
 log = logging.getLogger("planit.graph_model_metrics")
 
@@ -24,9 +25,10 @@ def _rule_view(g, vocab):
     return cats, [(int(s), int(t), EDGE_CLASSES[int(c)]) for s, t, c in g.edges]
 
 
-def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, gen_nodes: Path,
-        gen_edges: Path, sample_summary: Path, out: Path) -> dict:
+def run(config: dict, inp: Files, outputs: Files, room_type: str) -> dict:
     """Write ``metrics.json`` for the room type."""
+    model, nodes, edges, gen_nodes, gen_edges = inp.model, inp.nodes, inp.edges, inp.gen_nodes, inp.gen_edges
+    sample_summary, out = inp.sample_summary, outputs.metrics
     from ..corpus.procedural_rules import satisfaction
     from ..graphs import data as graph_data
     from ..evaluation import graphs as gm

@@ -4,9 +4,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..graphs.report import graph_report, write_report
+from ..stage import Files
 
 
-def run(nodes: Path, edges: Path, superstructures: Path, outputs: dict[str, Path]) -> dict:
+def run(config: dict, inp: Files, outputs: Files) -> dict:
+    nodes, edges, superstructures = inp.nodes, inp.edges, inp.superstructures
     report = graph_report(nodes, edges, superstructures)
     write_report(report, outputs)
     return {name: len(df) for name, df in report.items()}

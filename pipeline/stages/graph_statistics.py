@@ -10,12 +10,14 @@ import pyarrow as pa
 from .. import tables
 from ..config import config_hash
 from ..graphs.statistics import gather
+from ..stage import Files
 
 log = logging.getLogger("planit.graphs")
 STAT_TABLES = ("cooccurrence", "relations", "hub_patterns", "category_sizes")
 
 
-def run(config: dict, partials: list[Path], nodes: list[Path], outputs: dict[str, Path]) -> dict:
+def run(config: dict, inp: Files, outputs: Files) -> dict:
+    partials, nodes = inp.partial, inp.nodes
     for p in partials:  # a missing or corrupt shard is named here, not deep inside DuckDB
         tables.check(p, "partial_counts")
     for p in nodes:

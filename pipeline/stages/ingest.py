@@ -20,6 +20,7 @@ from ..corpus.ledger import Ledger
 from ..errors import InputError
 from ..log import progress
 from ..shards import shard_of
+from ..stage import Files
 
 log = logging.getLogger("planit.ingest")
 OUTPUTS = ("rooms", "architecture", "objects", "models", "ground_truth", "ingest_report", "drops")
@@ -152,7 +153,7 @@ def ingest_suncg(config: dict, shard: int, shards: int) -> dict[str, pa.Table]:
 SOURCES = {"procedural": ingest_procedural, "front3d": ingest_front3d, "ithor": ingest_ithor, "suncg": ingest_suncg}
 
 
-def run(config: dict, shard: int, outputs: dict[str, Path]) -> dict[str, int]:
+def run(config: dict, inp: Files, outputs: Files, shard: int) -> dict[str, int]:
     """Ingest shard ``shard`` of ``config['source']`` and write every table of :data:`OUTPUTS` to ``outputs``."""
     source, shards = config["source"], config["shards"]
     if not 0 <= shard < shards:

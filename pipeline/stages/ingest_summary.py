@@ -12,14 +12,16 @@ import pyarrow.compute  # noqa: F401  (pa.compute)
 
 from .. import duck, tables
 from ..errors import InputError
+from ..stage import Files
 
 log = logging.getLogger("planit.ingest")
 
 
-def run(rooms: list[Path], objects: list[Path], models: list[Path], reports: list[Path], drops: list[Path],
-        out_counts: Path, out_report: Path, out_drops: Path) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
     """Write ``category_counts``, the summed ``ingest_report`` (plus the distinct models over every shard) and every
     shard's ``drops`` in one table; print the top drop reasons. No room ingested at all is an error."""
+    rooms, objects, models, reports, drops = inp.rooms, inp.objects, inp.models, inp.reports, inp.drops
+    out_counts, out_report, out_drops = out.counts, out.report, out.drops
     room_t = tables.read_many(rooms, "rooms", columns=["room_id", "room_type"])
     if room_t.num_rows == 0:
         raise InputError(f"no room was ingested from any of the {len(rooms)} shard(s): see the ingest reports "

@@ -24,6 +24,7 @@ from ..placement.plan import ScenePlan, plans_from_tables
 from ..placement.retrieval import Catalog
 from ..placement.search import SCORED, instantiate
 from ..room import load_rooms
+from ..stage import Files
 
 log = logging.getLogger("planit.instantiate")
 
@@ -138,14 +139,14 @@ def scene_count(ic: dict, variant: dict) -> int:
     return min(n, variant.get("scenes", n))
 
 
-def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Path, model: Path, rooms: list[Path],
-        architecture: list[Path], objects: list[Path], models: list[Path], symmetry: Path, category_sizes: Path,
-        out_folder: Path, count: int | None = None, threads: int = 1) -> dict:
+def run(config: dict, inp: Files, out: Files, room_type: str, variant: str, count: int | None = None,
+        threads: int = 1) -> dict:
     """Place ``count`` scenes (default ``instantiate.scenes`` for sampled graphs, ``table3_scenes`` for held-out ones,
     at most the variant's own ``scenes``) with
     ``threads`` CPU threads for the networks (more than the job's cores oversubscribe them: 4x slower)."""
     import torch
 
+    variant_name = variant
     torch.set_num_threads(threads)
     ic = config["instantiate"]
     if variant_name not in ic["variants"]:
@@ -154,18 +155,19 @@ def run(config: dict, room_type: str, variant_name: str, nodes: Path, edges: Pat
     from ..learning import checkpoint
     from ..methods.planit.nets.train import KIND
 
-    saved = checkpoint.load(model, KIND)
-    ctx = load_context(config, room_type, saved, rooms, architecture, objects, models, symmetry, category_sizes)
+    saved = checkpoint.load(inp.model, KIND)
+    ctx = load_context(config, room_type, saved, inp.rooms, inp.architecture, inp.objects, inp.models, inp.symmetry,
+                       inp.category_sizes)
     n = count or scene_count(ic, variant)
-    plans = select_plans(config, variant, ctx, nodes, edges, n)
+    plans = select_plans(config, variant, ctx, inp.nodes, inp.edges, n)
     if not plans:
-        log.warning("%s: no graph of room type '%s' to instantiate: writing empty tables", nodes, room_type)
+        log.warning("%s: no graph of room type '%s' to instantiate: writing empty tables", inp.nodes, room_type)
     proposer = make_proposer(variant["location"], saved, config["instantiate"])
-    return write_outputs(config, ctx, plans, proposer, variant, variant_name, out_folder)
+    return write_outputs(config, ctx, plans, proposer, variant, variant_name, out)
 
 
 def write_outputs(config: dict, ctx: Context, plans: list[ScenePlan], proposer, variant: dict, variant_name: str,
-                  out_folder: Path, keep: int = 0) -> dict:
+                  out: Files, keep: int = 0) -> dict:
     records, room_rows, arch_rows, obj_rows = [], [], [], []
     for plan in progress(plans, total=len(plans), desc=f"instantiate {ctx.room_type} ({variant_name})"):
         seed = zlib.crc32(f"{config['seed']}/{variant_name}/{plan.scene_id}".encode())
@@ -173,24 +175,24 @@ def write_outputs(config: dict, ctx: Context, plans: list[ScenePlan], proposer, 
         record, r, a, o = scene_rows(plan, ctx, outcome, walls, variant_name)
         if outcome.status != "placed":
             log.warning("scene %s %s: %s", plan.scene_id, outcome.status, outcome.reason)
-        write_scene_files(out_folder / "scenes", plan, ctx, outcome, walls, record)
+        write_scene_files(out.files, plan, ctx, outcome, walls, record)
         records.append(record)
         room_rows += r
         arch_rows += a
         obj_rows += o
     objs = pd.DataFrame(obj_rows, columns=[*tables.SCHEMAS["generated_objects"].names, "_yaw"]).drop(columns="_yaw")
     used = set(objs["model_id"])
-    tables.write(out_folder / "rooms.parquet", "rooms", tables.from_rows("rooms", room_rows))
-    tables.write(out_folder / "architecture.parquet", "architecture", tables.from_rows("architecture", arch_rows))
-    tables.write(out_folder / "objects.parquet", "generated_objects", tables.from_rows("generated_objects", tables.records(objs)))
+    tables.write(out.rooms, "rooms", tables.from_rows("rooms", room_rows))
+    tables.write(out.architecture, "architecture", tables.from_rows("architecture", arch_rows))
+    tables.write(out.objects, "generated_objects", tables.from_rows("generated_objects", tables.records(objs)))
     model_rows = pd.concat([tables.read(p, "models", filters=[("model_id", "in", sorted(used))]).to_pandas()
                             for p in (ctx.models if used else [])] + [tables.empty("models").to_pandas()])
-    tables.write(out_folder / "models.parquet", "models", tables.from_rows("models", tables.records(model_rows.drop_duplicates("model_id"))))
-    (out_folder / "scenes").mkdir(parents=True, exist_ok=True)
+    tables.write(out.models, "models", tables.from_rows("models", tables.records(model_rows.drop_duplicates("model_id"))))
+    Path(out.files).mkdir(parents=True, exist_ok=True)
     scenes = pd.DataFrame(records, columns=tables.SCHEMAS["scenes"].names)
-    tables.write(out_folder / "scenes.parquet", "scenes", tables.from_rows("scenes", records))
+    tables.write(out.scenes, "scenes", tables.from_rows("scenes", records))
     summary = summarise(scenes)
-    tables.write_json(out_folder / "summary.json", {"room_type": ctx.room_type, "variant": variant_name, **variant, **summary})
+    tables.write_json(out.summary, {"room_type": ctx.room_type, "variant": variant_name, **variant, **summary})
     return summary
 
 
@@ -209,20 +211,3 @@ def summarise(scenes: pd.DataFrame) -> dict:
             "collision_rate": round(float(scenes["colliding_objects"].sum() / max(scenes["placed_objects"].sum(), 1)), 4),
             "median_seconds": round(float(scenes["seconds"].median()), 3),
             "unplanned_adjacent_per_scene": round(float(scenes["unplanned_adjacent"].mean()), 3)}
-
-
-TABLE3_COLUMNS = ["variant", "scenes", "placed", "failed", "rejections_per_scene", "backtracks_per_insertion", "violation",
-                  "consistency", "collision_rate", "median_seconds", "unplanned_adjacent_per_scene"]
-
-
-def table3(summaries: list[Path], out: Path) -> pd.DataFrame:
-    """One row per variant's summary.json (PlanIT's Table 3 and our consistency), written as CSV."""
-    rows = []
-    for p in summaries:
-        try:
-            rows.append(json.loads(Path(p).read_text()))
-        except (OSError, json.JSONDecodeError) as exc:
-            raise InputError(f"{p}: not a readable instantiation summary ({exc}); rerun snakemake --forcerun instantiate") from exc
-    frame = pd.DataFrame(rows).reindex(columns=["room_type", *TABLE3_COLUMNS])
-    tables.write_csv(out, frame)
-    return frame

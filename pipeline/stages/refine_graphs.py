@@ -9,6 +9,7 @@ from ..config import config_hash
 from ..graphs.refine import Stats, refine_room
 from ..graphs.statistics import parse_candidates
 from ..log import progress
+from ..stage import Files
 
 log = logging.getLogger("planit.graphs")
 
@@ -26,8 +27,8 @@ def load_stats(relations: Path, hub_patterns: Path, category_sizes: Path) -> Sta
     return s
 
 
-def run(config: dict, shard: int, nodes: Path, edges: Path, candidates: Path, stats: dict[str, Path],
-        outputs: dict[str, Path]) -> dict:
+def run(config: dict, inp: Files, outputs: Files, shard: int) -> dict:
+    nodes, edges, candidates, stats = inp.nodes, inp.edges, inp.candidates, inp
     cfg = config["refine"]
     st = load_stats(stats["relations"], stats["hub_patterns"], stats["category_sizes"])
     node_rows, edge_rows = tables.records_by_room(nodes, "nodes"), tables.records_by_room(edges, "edges")

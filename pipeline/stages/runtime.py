@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from .. import tables
+from ..stage import Files
 
 log = logging.getLogger("planit.runtime")
 
@@ -45,7 +46,9 @@ def per_rule(jobs: pd.DataFrame) -> pd.DataFrame:
     return out.round({"job_seconds": 1, "peak_rss_mb": 0, "share": 3})
 
 
-def run(benchmarks: Path, out: Path) -> pd.DataFrame:
+def run(config: dict, inp: Files, outputs: Files, benchmarks: str) -> pd.DataFrame:
+    out = outputs.table
+    benchmarks = Path(benchmarks)
     table = per_rule(read_benchmarks(benchmarks))
     tables.write_csv(out, table)
     for row in table.head(8).itertuples(index=False):

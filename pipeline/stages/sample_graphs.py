@@ -11,6 +11,7 @@ from pathlib import Path
 from .. import tables
 from ..errors import InputError
 from ..log import progress
+from ..stage import Files
 from .train_graph_model import room_graphs
 
 log = logging.getLogger("planit.sample_graphs")
@@ -44,9 +45,11 @@ def load_model(path: Path):
     return saved, vocab, model
 
 
-def run(config: dict, room_type: str, model: Path, nodes: Path, edges: Path, out_nodes: Path, out_edges: Path,
-        out_summary: Path, spec: Path | None = None, count: int | None = None, threads: int = 1) -> dict:
-    """Write ``count`` (default ``graph_model.sample.graphs``) valid graphs and a summary of the sampling."""
+def run(config: dict, inp: Files, out: Files, room_type: str, count: int | None = None, threads: int = 1) -> dict:
+    """Write ``count`` (default ``graph_model.sample.graphs``) valid graphs and a summary of the sampling; with
+    ``inp.spec``, graphs that complete that partial graph."""
+    model, nodes, edges, spec = inp.model, inp.nodes, inp.edges, inp.spec
+    out_nodes, out_edges, out_summary = out.nodes, out.edges, out.summary
     import torch
 
     from ..methods.planit.graph_model.spec import load_spec

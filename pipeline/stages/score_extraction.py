@@ -7,13 +7,15 @@ from pathlib import Path
 
 from .. import tables
 from ..scoring import extraction_counts, extraction_scores
+from ..stage import Files
 
 log = logging.getLogger("planit.score")
 
 
-def run(nodes: list[Path], edges: list[Path], ground_truth: list[Path], out: Path) -> dict:
+def run(config: dict, inp: Files, outputs: Files) -> dict:
     """Counts shard by shard (shard k's rooms, edges and ground truth), then the scores: memory does not grow
     with the corpus."""
+    nodes, edges, ground_truth, out = inp.nodes, inp.edges, inp.ground_truth, outputs.metrics
     if not len(nodes) == len(edges) == len(ground_truth):
         raise tables.TableError(f"score: {len(nodes)} node, {len(edges)} edge and {len(ground_truth)} ground-truth "
                                 "tables: one of each per shard")

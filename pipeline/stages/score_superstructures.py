@@ -6,11 +6,13 @@ from pathlib import Path
 
 from .. import tables
 from ..scoring import superstructure_scores
+from ..stage import Files
 
 log = logging.getLogger("planit.score")
 
 
-def run(nodes: Path, superstructures: Path, ground_truth: list[Path], out: Path) -> dict:
+def run(config: dict, inp: Files, outputs: Files) -> dict:
+    nodes, superstructures, ground_truth, out = inp.nodes, inp.superstructures, inp.ground_truth, outputs.metrics
     rooms = set(tables.read(nodes, "final_nodes", columns=["room_id"]).column("room_id").to_pylist())
     gt = tables.read_many(ground_truth, "ground_truth", filters=[("relation", "in", ["hub", "chain"])]).to_pandas()
     metrics = {"rooms": len(rooms), **superstructure_scores(

@@ -10,11 +10,13 @@ import pyarrow as pa
 from .. import tables
 from ..config import config_hash
 from ..graphs.statistics import PARTIAL_KEYS, candidates, shard_counts
+from ..stage import Files
 
 log = logging.getLogger("planit.graphs")
 
 
-def run(config: dict, nodes: Path, edges: Path, out_counts: Path, out_candidates: Path) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
+    nodes, edges, out_counts, out_candidates = inp.nodes, inp.edges, out.counts, out.candidates
     cfg = config["refine"]
     node_rows, edge_rows = tables.records_by_room(nodes, "nodes"), tables.records_by_room(edges, "edges")
     rows, patterns = candidates(((n, edge_rows.get(r, [])) for r, n in node_rows.items()), cfg)

@@ -10,6 +10,7 @@ from .. import tables
 from ..config import config_hash
 from ..geometry import symmetry
 from ..log import progress
+from ..stage import Files
 
 log = logging.getLogger("planit.symmetry")
 
@@ -24,8 +25,9 @@ def _unique_models(paths: list[Path]) -> list[dict]:
     return sorted(out, key=lambda r: r["model_id"])
 
 
-def run(config: dict, models: list[Path], out_table: Path, out_agreement: Path) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
     """Write the ``symmetry`` table and ``agreement.json`` (how often detection agrees with the table)."""
+    models, out_table, out_agreement = inp.models, out.table, out.agreement
     cfg = config["extract"]["symmetry"]
     rows = []
     for m in progress(_unique_models(models), desc="symmetry"):

@@ -8,6 +8,7 @@ from .. import tables
 from ..config import config_hash
 from ..errors import InputError
 from ..log import progress
+from ..stage import Files
 
 log = logging.getLogger("planit.train_graph_model")
 
@@ -35,15 +36,15 @@ def splits(room_ids: list[str], gm: dict, seed: int) -> tuple[list[str], list[st
     return fit, validation, test
 
 
-def run(config: dict, room_type: str, nodes: Path, edges: Path, out_model: Path, out_history: Path, out_curve: Path,
-        out_summary: Path, threads: int = 1) -> dict:
+def run(config: dict, inp: Files, out: Files, room_type: str, threads: int = 1) -> dict:
     """Train, write the best weights (with vocabulary, split, the test NLL and seen edge types), the loss curves and
-    a summary. The checkpoint beside ``out_model`` resumes an interrupted run with the same settings."""
+    a summary. The checkpoint beside ``out.model`` resumes an interrupted run with the same settings."""
+    nodes, edges = inp.nodes, inp.edges
+    out_model, out_history, out_curve, out_summary = out.model, out.history, out.curve, out.summary
     import torch
 
     from ..graphs import checks as graph_checks
     from ..learning import checkpoint
-
     from ..methods.planit.graph_model import train
 
     gm = config["graph_model"]

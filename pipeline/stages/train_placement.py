@@ -13,6 +13,7 @@ from ..config import config_hash
 from ..errors import InputError
 from ..log import progress
 from ..room import load_rooms
+from ..stage import Files
 
 log = logging.getLogger("planit.train_placement")
 
@@ -36,9 +37,11 @@ def training_rooms(config: dict, room_type: str, rooms, architecture, objects, n
     return cats, [make(i) for i in train_ids if i in inputs], [make(i) for i in held_ids if i in inputs], held_ids
 
 
-def run(config: dict, room_type: str, net: str, rooms: list[Path], architecture: list[Path], objects: list[Path],
-        nodes: Path, edges: Path, out_model: Path, out_history: Path, out_curve: Path, out_summary: Path,
-        threads: int = 1) -> dict:
+def run(config: dict, inp: Files, out: Files, room_type: str, net: str, threads: int = 1) -> dict:
+    rooms, architecture, objects, nodes, edges = inp.rooms, inp.architecture, inp.objects, inp.nodes, inp.edges
+    out_model, out_history, out_curve, out_summary = out.model, out.history, out.curve, out.summary
+    if net not in ("cfcn", "fcn"):
+        raise InputError(f"--net: '{net}' is not one of cfcn, fcn")
     import torch
 
     from ..methods.planit.nets import train as placement_train

@@ -1,0 +1,90 @@
+"""The layout the design fixes: rule name = CLI subcommand = stage module, stages declared once, thin stages,
+torch only in the learners' packages, layers kept (import-linter)."""
+import ast
+import importlib
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+
+PKG = ROOT / "pipeline"
+BIN = Path(sys.executable).parent
+RULE = re.compile(r"^rule (\w+):", re.M)
+
+
+def rule_blocks() -> dict[str, str]:
+    """Rule name -> its text, over every rule file."""
+    out = {}
+    for f in sorted((ROOT / "rules").glob("*.smk")):
+        parts = re.split(r"(?m)^(?=rule )", f.read_text())
+        out.update({m.group(1): p for p in parts if (m := RULE.match(p))})
+    return out
+
+
+def test_every_rule_is_a_stage_of_the_same_name_and_every_stage_has_a_rule():
+    from pipeline.stages import STAGES
+
+    blocks = rule_blocks()
+    assert set(blocks) == set(STAGES), set(blocks) ^ set(STAGES)
+    for name, text in blocks.items():
+        assert f'io=stage_io("{name}")' in text and "        STAGE\n" in text, name
+        assert hasattr(importlib.import_module(f"pipeline.stages.{name}"), "run"), name
+
+
+def test_every_stage_is_a_subcommand_of_its_name():
+    from pipeline.stages import STAGES
+
+    out = subprocess.run([str(BIN / "planit"), "--help"], capture_output=True, text=True, timeout=120,
+                         env={"COLUMNS": "200", "PATH": str(BIN)})
+    listed = set(re.findall(r"^│ (\w+)\s", out.stdout, re.M))
+    assert set(STAGES) <= listed, set(STAGES) - listed
+
+
+def test_a_rule_whose_files_differ_from_its_stage_declaration_is_refused(tmp_path):
+    """stage_io checks a rule's named files against the declaration when Snakemake builds the jobs."""
+    extra = tmp_path / "Snakefile"
+    extra.write_text(f'include: "{ROOT}/rules/common.smk"\n\n'
+                     'rule symmetry:\n    input:\n        modelz=["m.parquet"]\n    output:\n        table="t.parquet",\n'
+                     '        agreement="a.json"\n    params:\n        config=keys(),\n        io=stage_io("symmetry")\n'
+                     '    log:\n        "l.log"\n    shell:\n        STAGE\n')
+    (tmp_path / "m.parquet").write_text("")
+    out = subprocess.run([str(BIN / "snakemake"), "t.parquet", "-s", str(extra), "-d", str(tmp_path), "-n", "--configfile",
+                          str(ROOT / "config/config.yaml")], capture_output=True, text=True, timeout=300)
+    assert out.returncode != 0 and "rule symmetry: named inputs ['modelz']" in out.stdout + out.stderr
+
+
+def _imports(path: Path) -> set[str]:
+    """Every module a file imports, at any depth (function-level imports included), as absolute names."""
+    tree = ast.parse(path.read_text())
+    pkg = ".".join(path.relative_to(ROOT).with_suffix("").parts)
+    pkg = pkg if path.name == "__init__.py" else pkg.rsplit(".", 1)[0]
+    pkg = pkg.removesuffix(".__init__")
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = pkg.split(".")[:len(pkg.split(".")) - node.level + 1] if node.level else []
+            mod = ".".join([*base, node.module] if node.module else base)
+            out.add(mod)
+            out |= {f"{mod}.{a.name}" for a in node.names}
+    return out
+
+
+TORCH_HOMES = ("pipeline.methods.planit.graph_model", "pipeline.methods.planit.nets", "pipeline.learning",
+               "pipeline.evaluation.sca")
+
+
+def test_torch_is_imported_only_in_the_learners_packages():
+    offenders = []
+    for f in sorted(PKG.rglob("*.py")):
+        name = ".".join(f.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__")
+        if any(name == h or name.startswith(h + ".") for h in TORCH_HOMES):
+            continue
+        if any(m == "torch" or m.startswith("torch.") for m in _imports(f)):
+            offenders.append(name)
+    assert not offenders, offenders
