@@ -1,9 +1,10 @@
 """Compare two runs' results/ folders value by value: every Parquet table (wall-clock columns aside), every JSON
 and CSV file (timing keys and columns aside), and the trained weights of every model file.
 
-    .venv/bin/python bench/compare_runs.py RESULTS_BEFORE RESULTS_AFTER [--rename OLD=NEW ...]
+    .venv/bin/python bench/compare_runs.py RESULTS_BEFORE RESULTS_AFTER [--rename OLD=NEW ...] [--unordered GLOB ...]
 
-``--rename OLD=NEW`` maps a path prefix of the first run to the second's (a folder renamed between them). The exit
+``--rename OLD=NEW`` maps a path prefix of the first run to the second's (a folder renamed between them);
+``--unordered GLOB``: tables matching GLOB are compared as sets of rows (their row order changed on purpose). The exit
 status is 0 when everything that exists in the first run exists in the second with the same values.
 """
 from __future__ import annotations
@@ -28,10 +29,13 @@ def _strip(value):
     return value
 
 
-def same_table(a: Path, b: Path) -> bool:
+def same_table(a: Path, b: Path, unordered: bool = False) -> bool:
     ta, tb = pq.read_table(a), pq.read_table(b)
     drop = lambda t: t.drop_columns([c for c in TIMING if c in t.column_names])
-    return drop(ta).equals(drop(tb))
+    if not unordered:
+        return drop(ta).equals(drop(tb))
+    rows = lambda t: sorted(map(repr, drop(t).to_pylist()))
+    return ta.schema.equals(tb.schema) and rows(ta) == rows(tb)
 
 
 def same_csv(a: Path, b: Path) -> bool:
@@ -82,6 +86,7 @@ def main() -> int:
     ap.add_argument("before", type=Path)
     ap.add_argument("after", type=Path)
     ap.add_argument("--rename", action="append", default=[], help="OLD=NEW path prefix of the first run in the second")
+    ap.add_argument("--unordered", action="append", default=[], help="GLOB of tables compared as sets of rows")
     args = ap.parse_args()
     renames = [r.split("=", 1) for r in args.rename]
     counts, bad = {}, []
@@ -93,6 +98,8 @@ def main() -> int:
             rel = new + rel[len(old):] if rel.startswith(old) else rel
         g = args.after / rel
         check = same_weights if f.suffix == ".pt" else CHECKS[f.suffix]
+        if any(Path(rel).match(p) for p in args.unordered):
+            check = lambda x, y: same_table(x, y, unordered=True)
         if not g.exists() or not check(f, g):
             bad.append(rel + ("" if g.exists() else " (missing)"))
         counts[f.suffix] = counts.get(f.suffix, 0) + 1

@@ -220,6 +220,12 @@ SCHEMAS["scenes"] = pa.schema([
     _f("unplanned_adjacent", _I32, doc="of those, support or adjacent ones"),
     _f("colliding_objects", _I32, doc="objects penetrating another deeper than instantiate.checks.collision"),
 ])
+SCHEMAS["splits"] = pa.schema([
+    _f("room_id", _STR, nullable=False), _f("room_type", _CAT),
+    _f("split", _CAT, doc="fit | validation | heldout: the graph model fits on fit and stops on validation; every "
+                          "other learner trains on fit and validation; every method generates into, and the "
+                          "evaluation compares with, the held-out rooms"),
+])
 SCHEMAS["eval_scenes"] = pa.schema([
     _f("set", _CAT, nullable=False, doc="planit, a baseline variant, retrieval (nearest training room) or real_heldout"),
     _f("scene_id", _STR, nullable=False, doc="generated scene or real room id"), _f("room_type", _CAT),

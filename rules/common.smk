@@ -17,6 +17,8 @@ try:  # the CLI's validator: same defaults, and a bad key is named in one line
 except planit_config.ConfigError as exc:
     raise WorkflowError(str(exc)) from None
 
+from pipeline import methods as planit_methods
+from pipeline.methods.builtin import search_keys
 from pipeline.stage import option
 from pipeline.stages import STAGES
 from pipeline.workflow import prepare_jobs
@@ -24,6 +26,12 @@ from pipeline.workflow import prepare_jobs
 prepare_jobs(workflow.basedir)  # jobs find the `planit` beside this Python; each sees only its rule's keys
 
 SHARDS = list(range(config["shards"]))
+try:  # the methods config lists: built in, or registered by generation.plugins
+    planit_methods.load_plugins(config["generation"]["plugins"])
+    for _name in config["generation"]["methods"]:
+        planit_methods.get(_name)
+except Exception as exc:
+    raise WorkflowError(f"generation.methods: {exc}") from None
 ENV = "../environment.yml"
 
 
@@ -32,7 +40,8 @@ wildcard_constraints:
     shard="[0-9]+",
     room_type="[a-z][a-z0-9_]*",
     net="cfcn|fcn",
-    variant="|".join(config["instantiate"]["variants"]),
+    method="|".join(config["generation"]["methods"]),
+    variant="|".join(v for v, s in config["instantiate"]["variants"].items() if s["graphs"] == "heldout"),
 
 
 # ------------------------------------------------------------------------------------------- paths
@@ -60,11 +69,13 @@ REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
 GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
 PLACEMENT = "results/placement/{room_type}/{net}/{name}"
-GENERATED = "results/generated/{room_type}/{variant}/{name}"
+GENERATED = "results/generated/{room_type}/{method}/{name}"
+ABLATION = "results/generated/{room_type}/{variant}/{name}"  # Table 3's variants (held-out graphs)
 TABLE3 = "results/generated/{room_type}/table3.csv"
 EVAL = "results/eval/{room_type}/{name}"
+SPLIT = "results/splits/{room_type}.parquet"
 RUNTIME = "results/runtime.csv"
-EVAL_SETS = ["planit", *config["evaluate"]["baselines"]]
+METHODS = config["generation"]["methods"]
 VARIANTS = config["instantiate"]["variants"]
 TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldout"]
 # what placement training reads
@@ -80,12 +91,14 @@ def keys(*dotted):
     return json.dumps(planit_config.pick(config, dotted), sort_keys=True, separators=(",", ":"))
 
 
-def instantiate_keys(wildcards):
-    """Params function: the keys an instantiation job reads, its own variant's spec only (adding or changing another
-    variant reruns nothing here), and the evaluation's penetration measure its collision check confirms with."""
-    own = [f"instantiate.{k}" for k in config["instantiate"] if k not in ("variants", "table3_room_types")]
-    return keys("seed", "extract", "floor_contact", *own, f"instantiate.variants.{wildcards.variant}",
-                "evaluate.collision.penetration")
+def variant_keys(wildcards):
+    """Params function: the keys a Table 3 ablation's search reads (its own variant's spec only)."""
+    return keys(*search_keys(config, wildcards.variant))
+
+
+def method_keys(wildcards):
+    """Params function: the keys a method reads (adding or changing another method reruns nothing here)."""
+    return keys("generation.plugins", *planit_methods.get(wildcards.method).keys(config, wildcards.method))
 
 
 # Every stage rule runs its subcommand (named as the rule) with its named input and output files as options.
@@ -161,16 +174,25 @@ def graph_room_types():
     return list(config["filter"]["min_floor_objects"])
 
 
-def get_instantiate_inputs(wildcards):
-    """A variant's graphs (sampled, or the corpus's final ones) and placement networks (FCN for the unconditional
-    location, else the CFCN)."""
-    spec = VARIANTS[wildcards.variant]
-    if spec["graphs"] == "sampled":
-        graphs = {t: GRAPH_MODEL.format(room_type=wildcards.room_type, name=f"sampled/{t}.parquet") for t in ("nodes", "edges")}
-    else:
-        graphs = {t: GATHERED.format(corpus="ingested", table=t) for t in ("nodes", "edges")}
-    net = "fcn" if spec["location"] == "fcn" else "cfcn"
-    return {**graphs, "model": PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")}
+def get_method_inputs(wildcards):
+    """A method's inputs beside the corpus: its graph generator's sampled graphs, the placement networks it reads, its
+    reference method's rooms."""
+    m = planit_methods.get(wildcards.method)
+    out = {}
+    if m.graphs is not None:
+        out |= {t: GRAPH_MODEL.format(room_type=wildcards.room_type, name=f"sampled/{t}.parquet") for t in ("nodes", "edges")}
+    if m.model is not None:
+        out["model"] = PLACEMENT.format(room_type=wildcards.room_type, net=m.model, name="model.pt")
+    if m.reference is not None:
+        out |= {f"reference_{t}": GENERATED.format(room_type=wildcards.room_type, method=m.reference, name=f"{t}.parquet")
+                for t in ("rooms", "architecture", "objects", "scenes")}
+    return out
+
+
+def get_ablation_model(wildcards):
+    """A Table 3 variant's placement networks: the FCN for the unconditional location, else the CFCN."""
+    net = "fcn" if VARIANTS[wildcards.variant]["location"] == "fcn" else "cfcn"
+    return PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")
 
 
 def get_final_outputs():
@@ -183,7 +205,7 @@ def pipeline_outputs():
     return [
         *expand(GRAPH_MODEL, room_type=types, name=["metrics.json", "loss.png"]),
         *expand(PLACEMENT, room_type=types, net="cfcn", name="loss.png"),
-        *expand(GENERATED, room_type=types, variant="planit", name="summary.json"),
+        *expand(GENERATED, room_type=types, method=METHODS, name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
         *expand(EVAL, room_type=types, name="metrics.json"),
         FILTER_REPORT,

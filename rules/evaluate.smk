@@ -1,21 +1,22 @@
-# Evaluation (evaluation issue): the default generated rooms, the baselines and the held-out real rooms of one room
-# type scored by the same metrics (results/eval/<type>/metrics.json and one row per scene).
+# Evaluation: the rooms of every method of generation.methods and the held-out real rooms of one room type scored by
+# the same metrics (results/eval/<type>/metrics.json and one row per scene).
 
 
 rule evaluate:
     input:
-        summaries=expand(GENERATED, variant=EVAL_SETS, name="summary.json", allow_missing=True),
-        generated_rooms=expand(GENERATED, variant=EVAL_SETS, name="rooms.parquet", allow_missing=True),
-        generated_architecture=expand(GENERATED, variant=EVAL_SETS, name="architecture.parquet", allow_missing=True),
-        generated_objects=expand(GENERATED, variant=EVAL_SETS, name="objects.parquet", allow_missing=True),
-        generated_scenes=expand(GENERATED, variant=EVAL_SETS, name="scenes.parquet", allow_missing=True),
-        generated_files=expand(GENERATED, variant=EVAL_SETS, name="scenes", allow_missing=True),
+        summaries=expand(GENERATED, method=METHODS, name="summary.json", allow_missing=True),
+        generated_rooms=expand(GENERATED, method=METHODS, name="rooms.parquet", allow_missing=True),
+        generated_architecture=expand(GENERATED, method=METHODS, name="architecture.parquet", allow_missing=True),
+        generated_objects=expand(GENERATED, method=METHODS, name="objects.parquet", allow_missing=True),
+        generated_scenes=expand(GENERATED, method=METHODS, name="scenes.parquet", allow_missing=True),
+        generated_files=expand(GENERATED, method=METHODS, name="scenes", allow_missing=True),
         rooms=shards_of(FILTER_ROOMS),
         architecture=shards_of(INGEST, table="architecture"),
         objects=shards_of(INGEST, table="objects"),
         models=shards_of(INGEST, table="models"),
         nodes=GATHERED.format(corpus="ingested", table="nodes"),
         edges=GATHERED.format(corpus="ingested", table="edges"),
+        split=SPLIT,
         symmetry=SYMMETRY.format(corpus="ingested"),
     output:
         metrics=EVAL.replace("{name}", "metrics.json"),
@@ -26,7 +27,7 @@ rule evaluate:
                        caption="../report/gallery.rst", category="6. Gallery", subcategory="{room_type}",
                        labels={"room type": "{room_type}", "room": "{name}"}),
     params:
-        config=keys("seed", "source", "graph_model.heldout_fraction", "extract", "floor_contact", "evaluate"),
+        config=keys("seed", "source", "extract", "floor_contact", "evaluate"),
         io=stage_io("evaluate"),
     threads: 1
     log:

@@ -1,11 +1,31 @@
 # The graph generative model (PlanIT section 5), one per room type: train on the final graphs of the ingested
-# corpus, sample graphs in held-out rooms' architectures, evaluate them against the held-out graphs.
+# corpus, sample graphs in held-out rooms' architectures, evaluate them against the held-out graphs. The split of a
+# room type's rooms is written once (split_rooms) and read by every learner, method and the evaluation.
+
+
+rule split_rooms:
+    input:
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+    output:
+        split=SPLIT,
+    params:
+        config=keys("seed", "graph_model.heldout_fraction", "graph_model.validation_fraction"),
+        io=stage_io("split_rooms"),
+    log:
+        "logs/split_rooms/{room_type}.log",
+    benchmark:
+        "benchmarks/split_rooms/{room_type}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
 
 
 rule train_graph_model:
     input:
         nodes=GATHERED.format(corpus="ingested", table="nodes"),
         edges=GATHERED.format(corpus="ingested", table="edges"),
+        split=SPLIT,
     output:
         model=GRAPH_MODEL.replace("{name}", "model.pt"),
         history=GRAPH_MODEL.replace("{name}", "history.csv"),

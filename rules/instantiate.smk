@@ -1,5 +1,6 @@
-# Instantiation (PlanIT section 6): train the placement networks per room type, place sampled graphs (variant
-# planit) and the held-out rooms' graphs under Table 3's ablations, and gather Table 3.
+# Generation: train PlanIT's placement networks per room type; generate rooms with every method of
+# generation.methods (the method wildcard); place the held-out rooms' graphs under Table 3's ablations and gather
+# Table 3.
 
 
 rule train_placement:
@@ -9,6 +10,7 @@ rule train_placement:
         objects=shards_of(INGEST, table="objects"),
         nodes=GATHERED.format(corpus="ingested", table="nodes"),
         edges=GATHERED.format(corpus="ingested", table="edges"),
+        split=SPLIT,
     output:
         model=PLACEMENT.replace("{name}", "model.pt"),
         history=PLACEMENT.replace("{name}", "history.csv"),
@@ -17,7 +19,7 @@ rule train_placement:
                      labels={"room type": "{room_type}", "network": "{net}"}),
         summary=PLACEMENT.replace("{name}", "training.json"),
     params:
-        config=keys("seed", "graph_model.heldout_fraction", *(f"placement.{k}" for k in PLACEMENT_TRAIN_KEYS)),
+        config=keys("seed", *(f"placement.{k}" for k in PLACEMENT_TRAIN_KEYS)),
         io=stage_io("train_placement"),
     threads: 1  # more per job: set-threads in a profile
     resources:
@@ -32,25 +34,52 @@ rule train_placement:
         STAGE
 
 
-rule instantiate:
+rule generate:
     input:
-        unpack(get_instantiate_inputs),
+        unpack(get_method_inputs),
         rooms=shards_of(FILTER_ROOMS),
         architecture=shards_of(INGEST, table="architecture"),
         objects=shards_of(INGEST, table="objects"),
         models=shards_of(INGEST, table="models"),
+        split=SPLIT,
         symmetry=SYMMETRY.format(corpus="ingested"),
         category_sizes=STATS.format(corpus="ingested", name="category_sizes"),
     output:
-        rooms=GENERATED.replace("{name}", "rooms.parquet"),
-        architecture=GENERATED.replace("{name}", "architecture.parquet"),
-        objects=GENERATED.replace("{name}", "objects.parquet"),
-        models=GENERATED.replace("{name}", "models.parquet"),
-        scenes=GENERATED.replace("{name}", "scenes.parquet"),
+        **{t: GENERATED.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
         summary=GENERATED.replace("{name}", "summary.json"),
         files=directory(GENERATED.replace("{name}", "scenes")),
     params:
-        config=instantiate_keys,
+        config=method_keys,
+        io=stage_io("generate"),
+    threads: 1
+    log:
+        "logs/generate/{room_type}-{method}.log",
+    benchmark:
+        "benchmarks/generate/{room_type}-{method}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
+
+
+rule instantiate:
+    input:
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+        model=get_ablation_model,
+        rooms=shards_of(FILTER_ROOMS),
+        architecture=shards_of(INGEST, table="architecture"),
+        objects=shards_of(INGEST, table="objects"),
+        models=shards_of(INGEST, table="models"),
+        split=SPLIT,
+        symmetry=SYMMETRY.format(corpus="ingested"),
+        category_sizes=STATS.format(corpus="ingested", name="category_sizes"),
+    output:
+        **{t: ABLATION.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
+        summary=ABLATION.replace("{name}", "summary.json"),
+        files=directory(ABLATION.replace("{name}", "scenes")),
+    params:
+        config=variant_keys,
         io=stage_io("instantiate"),
     threads: 1
     log:
@@ -65,7 +94,7 @@ rule instantiate:
 
 rule table3:
     input:
-        summaries=expand(GENERATED, variant=TABLE3_VARIANTS, name="summary.json", allow_missing=True),
+        summaries=expand(ABLATION, variant=TABLE3_VARIANTS, name="summary.json", allow_missing=True),
     output:
         table=report(TABLE3, caption="../report/table3.rst", category="4. Instantiation (Table 3)",
                      labels={"room type": "{room_type}"}),

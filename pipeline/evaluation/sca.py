@@ -70,3 +70,11 @@ def sca(real_train: np.ndarray, real_test: np.ndarray, generated: np.ndarray, cf
         accs.append(100.0 * max(acc, 1.0 - acc))
     return {"mean": float(np.mean(accs)), "sd": float(np.std(accs)), "runs": accs, "train": len(train[1]),
             "test": len(test[1])}
+
+
+def sca_scores(real_maps: tuple[np.ndarray, np.ndarray], generated: np.ndarray, cfg: dict, threads: int, seed: int) -> dict:
+    """:func:`sca` of one set's renders against the real training and held-out renders, rounded for the report."""
+    torch.set_num_threads(max(threads, 1))
+    out = sca(real_maps[0], real_maps[1], generated, cfg, seed)
+    return {k: (round(v, 3) if isinstance(v, float) else v) for k, v in out.items() if k != "runs"} | {
+        "runs": [round(a, 3) for a in out["runs"]]}

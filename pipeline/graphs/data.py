@@ -204,3 +204,14 @@ def split_heldout(room_ids: list[str], fraction: float, seed: int, stream: int =
     k = min(max(k, 1 if len(ids) > 1 else 0), max(len(ids) - 1, 0))
     held = {ids[i] for i in perm[:k]}
     return [i for i in ids if i not in held], [i for i in ids if i in held]
+
+
+SPLITS = ("fit", "validation", "heldout")
+
+
+def room_splits(room_ids: list[str], heldout_fraction: float, validation_fraction: float, seed: int) -> dict[str, str]:
+    """Seeded split of a room type's rooms: room id -> fit | validation | heldout. The held-out rooms are the test
+    rooms of every learner and of the evaluation; the validation rooms come out of the rest."""
+    rest, held = split_heldout(room_ids, heldout_fraction, seed)
+    fit, validation = split_heldout(rest, validation_fraction, seed, stream=4343)
+    return {**{r: "fit" for r in fit}, **{r: "validation" for r in validation}, **{r: "heldout" for r in held}}

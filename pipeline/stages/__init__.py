@@ -12,6 +12,7 @@ METHOD = Param("method", help="a generation method (generation.methods)")
 CORPUS = (one("rooms", "the shard's rooms"), one("architecture"), one("objects"), one("models"))
 CORPUS_SHARDS = (many("rooms", "the kept rooms, one per shard"), many("architecture"), many("objects"), many("models"))
 GRAPHS = (one("nodes", "final nodes"), one("edges", "final edges"))
+SPLIT = one("split", "the room type's split (fit, validation, heldout)")
 TRAINING = (one("model", "the trained model"), one("history", "loss per epoch or step (CSV)"),
             one("curve", "loss curves (PNG)"), one("summary", "training summary (JSON)"))
 GENERATED = (one("rooms"), one("architecture"), one("objects"), one("models"),
@@ -53,8 +54,10 @@ _ALL = [
     Stage("graph_report", "Write the graph report: Table 1, pruning by rule, frequent relations (CSV) and a PNG.",
           inputs=(one("nodes"), one("edges"), one("superstructures")),
           outputs=(one("table1"), one("pruning"), one("relations"), one("plot"))),
+    Stage("split_rooms", "Split one room type's rooms into fit, validation and held-out rooms (seeded).",
+          inputs=(one("nodes", "final nodes"),), outputs=(one("split"),), params=(ROOM_TYPE,)),
     Stage("train_graph_model", "Train the graph generative model of one room type (resumes from the checkpoint "
-          "beside --out-model).", inputs=GRAPHS, outputs=TRAINING, params=(ROOM_TYPE,), threads=True),
+          "beside --out-model).", inputs=(*GRAPHS, SPLIT), outputs=TRAINING, params=(ROOM_TYPE,), threads=True),
     Stage("sample_graphs", "Sample relation graphs of a room type, from scratch or completing --spec.",
           inputs=(one("model", "the graph model"), *GRAPHS, one("spec", "complete this partial graph (YAML)", True)),
           outputs=(one("nodes"), one("edges"), one("summary")),
@@ -64,22 +67,32 @@ _ALL = [
                                                  one("sample_summary")),
           outputs=(one("metrics"),), params=(ROOM_TYPE,)),
     Stage("train_placement", "Train the location and orientation networks of one room type (resumes from the "
-          "checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS), outputs=TRAINING,
+          "checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT), outputs=TRAINING,
           params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned) or fcn (the unconditional ablation)")),
           threads=True),
-    Stage("instantiate", "Place graphs of one room type into rooms: canonical tables, a record per scene, GLB / PNG "
-          "/ JSON per scene.", inputs=(one("nodes", "graphs: generated (sampled) or final nodes"), one("edges"),
-                                       one("model", "placement networks"), *CORPUS_SHARDS, one("symmetry"),
-                                       one("category_sizes")),
+    Stage("generate", "Generate rooms of one room type with one method: canonical tables, a record per scene, "
+          "GLB / PNG / JSON per scene.",
+          inputs=(*CORPUS_SHARDS, SPLIT, one("symmetry"), one("category_sizes"),
+                  one("nodes", "the method's graphs (its graph generator's sampled nodes)", True),
+                  one("edges", optional=True), one("model", "the placement networks the method reads", True),
+                  *(one(f"reference_{t}", "the rooms of the method's reference method", True)
+                    for t in ("rooms", "architecture", "objects", "scenes"))),
+          outputs=GENERATED, params=(ROOM_TYPE, METHOD, Param("count", int, None, "scenes (default: the method's)")),
+          threads=True),
+    Stage("instantiate", "Place the held-out rooms' own graphs under one of Table 3's ablations "
+          "(instantiate.variants of held-out graphs).",
+          inputs=(one("nodes", "final nodes"), one("edges", "final edges"), one("model", "placement networks"),
+                  *CORPUS_SHARDS, SPLIT, one("symmetry"), one("category_sizes")),
           outputs=GENERATED, params=(ROOM_TYPE, Param("variant", help="a key of instantiate.variants"),
-                                     Param("count", int, None, "scenes (default from instantiate)")), threads=True),
+                                     Param("count", int, None, "scenes (default instantiate.table3_scenes)")),
+          threads=True),
     Stage("table3", "Gather the variants' summaries of one room type into PlanIT's Table 3 (CSV).",
           inputs=(many("summaries", "one per variant"),), outputs=(one("table"),)),
-    Stage("evaluate", "Score generated rooms, baselines and held-out real rooms of one room type with the same "
+    Stage("evaluate", "Score every method's rooms and the held-out real rooms of one room type with the same "
           "metrics.", inputs=(many("summaries", "one per generated set (its name: the summary's method)"),
                               many("generated_rooms"), many("generated_architecture"), many("generated_objects"),
                               many("generated_scenes"), many("generated_files", "each set's scene files (gallery)"),
-                              *CORPUS_SHARDS, *GRAPHS, one("symmetry")),
+                              *CORPUS_SHARDS, *GRAPHS, SPLIT, one("symmetry")),
           outputs=(one("metrics"), one("scenes"), one("table", "the sets side by side (CSV)"),
                    one("gallery", "folder of generated and real rooms (PNG, GLB)")), params=(ROOM_TYPE,),
           threads=True),

@@ -1,88 +1,33 @@
-"""Evaluate one room type's graph model: held-out NLL, generated vs held-out real graphs beside the sampling
-floor, validity, novelty, uniqueness and (procedural corpus) the generator's own arrangement rules."""
+"""Evaluate one room type's graph model: its sampled graphs against the held-out real graphs (metrics.json)."""
 from __future__ import annotations
 
 import json
 import logging
 from pathlib import Path
 
-import numpy as np
-
 from .. import tables
+from ..evaluation.graph_model import graph_model_metrics
+from ..graphs import data as graph_data
+from ..graphs.load import room_graphs
 from ..stage import Files
 
 log = logging.getLogger("planit.graph_model_metrics")
 
-# the issue's quality goals: each distance within this factor of its floor
-FLOOR_FACTOR = 1.5
 
-
-def _rule_view(g, vocab):
-    """(categories, edges with kind names) of a graph, for the procedural rules."""
-    from ..graphs.data import EDGE_CLASSES
-
-    cats = [vocab.node_classes[c] for c in g.node_class]
-    return cats, [(int(s), int(t), EDGE_CLASSES[int(c)]) for s, t, c in g.edges]
-
-
-def run(config: dict, inp: Files, outputs: Files, room_type: str) -> dict:
-    """Write ``metrics.json`` for the room type."""
-    model, nodes, edges, gen_nodes, gen_edges = inp.model, inp.nodes, inp.edges, inp.gen_nodes, inp.gen_edges
-    sample_summary, out = inp.sample_summary, outputs.metrics
-    from ..corpus.procedural_rules import satisfaction
-    from ..graphs import data as graph_data
-    from ..evaluation import graphs as gm
-    from .train_graph_model import room_graphs
-
+def run(config: dict, inp: Files, out: Files, room_type: str) -> dict:
     from ..learning import checkpoint
     from ..methods.planit.graph_model.train import KIND
 
-    saved = checkpoint.load(model, KIND).record
+    saved = checkpoint.load(inp.model, KIND).record
     vocab = graph_data.Vocab(tuple(saved["categories"]))
-    _, real = room_graphs(nodes, edges, room_type)
+    _, real = room_graphs(inp.nodes, inp.edges, room_type)
     by_id = {g.room_id: g for g in real}
     train = [by_id[i] for i in saved["train_ids"] if i in by_id]
     held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
-    gen = graph_data.graphs_from_tables(tables.read(gen_nodes, "generated_nodes").to_pandas(),
-                                        tables.read(gen_edges, "generated_edges").to_pandas(), vocab)
-    rng = np.random.default_rng([config["seed"], 99])
-    floor_set = [train[i] for i in rng.permutation(len(train))[:min(len(gen) or len(train), len(train))]]
-    classes = range(len(vocab.node_classes))
-    floor = gm.distances(held, floor_set, classes)
-    got = gm.distances(held, gen, classes) if gen else {k: None for k in floor}  # nothing valid was sampled
-    out_ = {
-        "room_type": room_type, "graphs": {"train": len(train), "heldout": len(held), "generated": len(gen),
-                                           "floor_sample": len(floor_set)},
-        "heldout_nll": saved["heldout_nll"],  # the chosen epoch's, scored once after training
-        "generated_vs_heldout": _rounded(got), "floor_real_vs_heldout": _rounded(floor),
-        "ratio_to_floor": {k: round(got[k] / floor[k], 3) if got[k] is not None and floor[k] > 0 else None for k in got},
-        "structures": {"generated": gm.structure_counts(gen), "heldout": gm.structure_counts(held)},
-        "valid_before_rejection": json.loads(Path(sample_summary).read_text())["valid_before_rejection"],
-        **gm.novelty_uniqueness(gen, train),
-        "heldout_novelty": gm.novelty_uniqueness(held, train)["novelty"],
-    }
-    if config["source"] == "procedural":
-        out_["rules"] = {"generated": satisfaction([_rule_view(g, vocab) for g in gen]),
-                         "real": satisfaction([_rule_view(g, vocab) for g in real])}
-    out_["goals"] = _goals(out_)
-    tables.write_json(out, out_)
-    log.info("%s: %s", room_type, out_["goals"])
-    return out_
-
-
-def _rounded(d: dict) -> dict:
-    return {k: None if v is None else round(v, 5) for k, v in d.items()}
-
-
-def _goals(m: dict) -> dict:
-    """The issue's quality goals, met or not (reported, never tuned against)."""
-    r = m["ratio_to_floor"]
-    goals = {f"{k}_within_{FLOOR_FACTOR}x_floor": (r[k] is not None and r[k] <= FLOOR_FACTOR)
-             for k in ("category_kl", "edge_type_kl", "node_count_tv")}
-    goals["valid_before_rejection_at_least_0.8"] = m["valid_before_rejection"] >= 0.8
-    goals["novelty_at_least_0.5"] = m["novelty"] >= 0.5
-    if "rules" in m:
-        gaps = [abs(g["share"] - m["rules"]["real"][k]["share"]) for k, g in m["rules"]["generated"].items()
-                if g["share"] is not None and m["rules"]["real"][k]["share"] is not None]
-        goals["rules_within_5_points"] = bool(gaps) and max(gaps) <= 0.05
-    return goals
+    gen = graph_data.graphs_from_tables(tables.read(inp.gen_nodes, "generated_nodes").to_pandas(),
+                                        tables.read(inp.gen_edges, "generated_edges").to_pandas(), vocab)
+    valid = json.loads(Path(inp.sample_summary).read_text())["valid_before_rejection"]
+    metrics = graph_model_metrics(config, room_type, vocab, real, train, held, gen, saved["heldout_nll"], valid)
+    tables.write_json(out.metrics, metrics)
+    log.info("%s: %s", room_type, metrics["goals"])
+    return metrics

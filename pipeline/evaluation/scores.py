@@ -1,0 +1,162 @@
+"""Per-scene rows and per-set figures of the evaluation: physical checks, walkability, nearest-training-room
+similarity, distribution distances beside their sampling floors, the goals and the table of sets."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..geometry.raycast import intersector_class
+from ..log import progress
+from . import distributions, physical, render, walkability
+from .sets import RoomSet
+
+
+
+def scene_rows(rs: RoomSet, meshes: dict, box_models: set, train_maps: np.ndarray, train_ids: list[str],
+               index: dict, config: dict) -> list[dict]:
+    """One ``eval_scenes`` row per room of a set."""
+    ev = config["evaluate"]
+    ccfg = {"max_penetration": ev["collision"]["max_penetration"], "penetration": ev["collision"]["penetration"],
+            "intersector": intersector_class(config["extract"]["backend"])}
+    records = rs.scenes.set_index("scene_id") if rs.scenes is not None else None
+    rows = []
+    for room, parents in progress(list(zip(rs.rooms, rs.parents)), desc=f"scoring {rs.name}"):
+        mesh = [None if m in box_models else meshes.get(m) for m in room.model_ids]
+        walk = walkability.walkability(room, ev["walk"])
+        sim = render.similarity(render.label_map(room, index, ev["render"]["size"], ev["render"]["mpp"]), train_maps)
+        sim[[k for k, t in enumerate(train_ids) if t == room.room_id]] = -1.0  # a training room is not its own neighbour
+        nn = int(np.argmax(sim)) if len(sim) else None
+        rec = records.loc[room.room_id] if records is not None and room.room_id in records.index else None
+        rows.append({
+            "set": rs.name, "scene_id": room.room_id, "room_type": room.room_type, "objects": len(room.object_ids),
+            "colliding_objects": int(physical.colliding(room, parents, mesh, ccfg).sum()),
+            "out_of_bounds": int(physical.out_of_bounds(room.outline, room.boxes, ev["out_of_bounds"]["erode"],
+                                                        ev["out_of_bounds"]["tolerance"]).sum()),
+            "walkable_share": walk["walkable_share"], "reachable": walk["reachable"],
+            "nn_similarity": None if nn is None else float(sim[nn]), "nn_room_id": None if nn is None else train_ids[nn],
+            "consistency": _optional(rec, "consistency"), "violation": _optional(rec, "violation")})
+    return rows
+
+
+def rule_view(graph) -> tuple[list[str], list[tuple[int, int, str]]]:
+    """(categories, edges with kind names) of an extracted room graph, for the procedural generator's rules."""
+    ids = {n["node_id"]: k for k, n in enumerate(graph.nodes)}
+    cats = [n["category"] if n["kind"] == "object" else n["kind"] for n in graph.nodes]
+    kind = lambda e: "support" if e["edge_type"] == "support" else (
+        f"{e['direction']}/{e['distance']}" if e["edge_type"] == "spatial" else e["edge_type"])
+    return cats, [(ids[e["source"]], ids[e["target"]], kind(e)) for e in graph.edges
+                  if e["source"] in ids and e["target"] in ids]
+
+
+def rule_satisfaction(rs: RoomSet, checker) -> dict:
+    """The procedural generator's arrangement rules on each room's extracted graph (the project's extraction)."""
+    from ..corpus.procedural_rules import satisfaction  # the procedural corpus's rules: an oracle for its rooms only
+
+    return satisfaction([rule_view(checker.extract(r)) for r in progress(rs.rooms, desc=f"rules {rs.name}")])
+
+
+def set_summary(rows: pd.DataFrame, rs: RoomSet, real: RoomSet, eps: float) -> dict:
+    """Set-level figures of one set's scene rows against the held-out real rooms."""
+    objects = max(int(rows["objects"].sum()), 1)
+    mean = lambda col: None if rows[col].isna().all() else round(float(rows[col].mean()), 5)
+    return {
+        "scenes": len(rows), "attempted": rs.attempted,
+        "partial": 0 if rs.scenes is None else int((rs.scenes["status"].astype(str) == "partial").sum()),
+        "category_kl": round(distributions.category_kl(_categories(real), _categories(rs), eps), 6),
+        "count_distance": round(distributions.count_distance([len(r.object_ids) for r in real.rooms],
+                                                             [len(r.object_ids) for r in rs.rooms]), 5),
+        "object_collision_rate": round(float(rows["colliding_objects"].sum() / objects), 5),
+        "scene_collision_rate": round(float((rows["colliding_objects"] > 0).mean()), 5) if len(rows) else None,
+        "out_of_bounds_rate": round(float(rows["out_of_bounds"].sum() / objects), 5),
+        "walkable_share": mean("walkable_share"),
+        "reachable_scenes": round(float((rows["reachable"] >= 1.0).mean()), 5) if len(rows) else None,
+        "consistency": mean("consistency"), "violation": mean("violation"),
+        "nn_similarity": {"mean": mean("nn_similarity"),
+                          "sd": None if len(rows) < 2 else round(float(rows["nn_similarity"].std(ddof=0)), 5)},
+    }
+
+
+def _categories(rs: RoomSet) -> list[str]:
+    return distributions.flatten([r.categories for r in rs.rooms])
+
+
+def floors(train: RoomSet, real: RoomSet, generated: int, cfg: dict, seed: int) -> dict:
+    """The category KL and count distance between two disjoint sets of real rooms of the held-out and generated
+    sizes (what sample size alone costs)."""
+    pool = [r for s in (train, real) for r in s.rooms]
+    sizes = (len(real.rooms), generated)
+    kl = lambda a, b: distributions.category_kl(distributions.flatten([r.categories for r in a]),
+                                                distributions.flatten([r.categories for r in b]), cfg["kl_eps"])
+    count = lambda a, b: distributions.count_distance([len(r.object_ids) for r in a], [len(r.object_ids) for r in b])
+    return {"category_kl": distributions.sampling_floor(pool, sizes, kl, cfg["floor_repeats"], seed),
+            "count_distance": distributions.sampling_floor(pool, sizes, count, cfg["floor_repeats"], seed)}
+
+
+def train_similarity(train_maps: np.ndarray, sample: int, seed: int) -> dict:
+    """A training room's similarity to its nearest other training room, over a seeded sample of them."""
+    if len(train_maps) < 2:
+        return {"mean": None, "sd": None, "rooms": 0}
+    pick = np.random.default_rng([seed, 31]).permutation(len(train_maps))[:sample]
+    best = []
+    for k in pick:
+        sim = render.similarity(train_maps[k], train_maps)
+        sim[k] = -1.0
+        best.append(sim.max())
+    return {"mean": round(float(np.mean(best)), 5), "sd": round(float(np.std(best)), 5), "rooms": len(pick)}
+
+
+def goals(sets: dict, fl: dict, first: str, real: str) -> dict:
+    """The evaluation issue's goals for the first method's rooms (reported, never tuned against)."""
+    g, r = sets[first], sets[real]
+    within = lambda key: (fl[key]["mean"] == fl[key]["mean"] and g[key] <= 1.5 * max(fl[key]["mean"], 1e-9))
+    out = {"category_kl_within_1.5x_floor": within("category_kl"),
+           "count_distance_within_1.5x_floor": within("count_distance"),
+           "collision_rate_at_most_real": g["object_collision_rate"] <= r["object_collision_rate"],
+           "out_of_bounds_rate_at_most_real": g["out_of_bounds_rate"] <= r["out_of_bounds_rate"],
+           "walkable_within_5_points_of_real": (g["walkable_share"] is not None and r["walkable_share"] is not None
+                                                and abs(g["walkable_share"] - r["walkable_share"]) <= 0.05)}
+    if g.get("sca") and g["sca"]["mean"] == g["sca"]["mean"]:
+        out["sca_at_most_60"] = g["sca"]["mean"] <= 60.0
+    return {k: bool(v) for k, v in out.items()}
+
+
+def finite(value):
+    """JSON-safe: NaN and infinities become None (recursively)."""
+    if isinstance(value, dict):
+        return {k: finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite(v) for v in value]
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def label_maps(rs: RoomSet, index: dict, cfg: dict) -> np.ndarray:
+    """``(n, size, size)`` int16 label maps of a set's rooms."""
+    size = cfg["size"]
+    maps = [render.label_map(r, index, size, cfg["mpp"]) for r in rs.rooms]
+    return np.stack(maps) if maps else np.zeros((0, size, size), np.int16)
+
+
+TABLE_COLUMNS = ["scenes", "attempted", "category_kl", "count_distance", "object_collision_rate", "scene_collision_rate",
+                 "out_of_bounds_rate", "walkable_share", "reachable_scenes", "consistency", "violation"]
+
+
+def metrics_table(metrics: dict) -> pd.DataFrame:
+    """One row per set (the sampling floors and the training rooms' own similarity as rows of their own)."""
+    rows = [{"set": name, **{k: s[k] for k in TABLE_COLUMNS}, "nn_similarity": s["nn_similarity"]["mean"],
+             "sca_mean": (s.get("sca") or {}).get("mean"), "sca_sd": (s.get("sca") or {}).get("sd")}
+            for name, s in metrics["sets"].items()]
+    fl = metrics["floors"]
+    rows.append({"set": "floor (real vs real)", "category_kl": fl["category_kl"]["mean"],
+                 "count_distance": fl["count_distance"]["mean"]})
+    rows.append({"set": "training vs nearest training", "nn_similarity": metrics["train_nn_similarity"]["mean"]})
+    frame = pd.DataFrame(rows, columns=["set", *TABLE_COLUMNS, "nn_similarity", "sca_mean", "sca_sd"])
+    return frame.astype({"scenes": "Int64", "attempted": "Int64"})
+
+
+def _optional(record, column: str):
+    """A float of a scene's instantiation record, None where there is no record or no value."""
+    if record is None or pd.isna(record[column]):
+        return None
+    return float(record[column])

@@ -1,0 +1,66 @@
+"""The generation methods, registered in one place: :data:`BUILTIN` below, and any module a config names in
+``generation.plugins`` (it calls :func:`register` when imported). See ``interface.py`` for the contract and
+``docs/adding-a-method.md`` for a walk through a toy method."""
+from __future__ import annotations
+
+import importlib
+
+from ..errors import InputError
+from .interface import Corpus, Generated, GraphGenerator, LayoutGenerator, Method, Scene, Task
+
+__all__ = ["Corpus", "Generated", "GraphGenerator", "LayoutGenerator", "Method", "Scene", "Task", "register", "get",
+           "names", "load_plugins", "layout_of", "graph_generator"]
+
+_METHODS: dict[str, Method] = {}
+GRAPH_GENERATORS = {"planit": "pipeline.methods.planit.graph_model.generator:GraphModel"}
+
+
+def register(method: Method) -> Method:
+    """Add a method (a name registered twice is an error unless it is the same method)."""
+    known = _METHODS.get(method.name)
+    if known is not None and known != method:
+        raise InputError(f"generation method '{method.name}' is registered twice")
+    _METHODS[method.name] = method
+    return method
+
+
+def load_plugins(modules: list[str]) -> None:
+    """Import each module of ``generation.plugins`` (they register their methods)."""
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except ImportError as exc:
+            raise InputError(f"generation.plugins: cannot import '{name}' ({exc})") from None
+
+
+def get(name: str) -> Method:
+    if name not in _METHODS:
+        raise InputError(f"generation method '{name}' is not registered (known: {', '.join(sorted(_METHODS))}; "
+                         "generation.plugins names modules that register more)")
+    return _METHODS[name]
+
+
+def names() -> list[str]:
+    return sorted(_METHODS)
+
+
+def _load(path: str):
+    module, _, attr = path.partition(":")
+    return getattr(importlib.import_module(module), attr)
+
+
+def layout_of(method: Method, config: dict) -> LayoutGenerator:
+    """The method's layout generator, built for ``config``."""
+    return _load(method.layout)(config, method.name)
+
+
+def graph_generator(name: str) -> GraphGenerator:
+    if name not in GRAPH_GENERATORS:
+        raise InputError(f"no graph generator '{name}' (known: {', '.join(sorted(GRAPH_GENERATORS))})")
+    return _load(GRAPH_GENERATORS[name])()
+
+
+from .builtin import BUILTIN  # noqa: E402
+
+for _m in BUILTIN:
+    register(_m)

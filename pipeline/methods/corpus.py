@@ -1,0 +1,28 @@
+"""Reading what every method may read of one room type (:class:`~pipeline.methods.interface.Corpus`) and another
+method's generated rooms (:class:`~pipeline.methods.interface.Generated`)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .. import tables
+from ..graphs.load import read_split
+from ..room import load_rooms
+from .interface import Corpus, Generated
+
+
+def load_corpus(room_type: str, rooms: list[Path], architecture: list[Path], objects: list[Path], models: list[Path],
+                split: Path, symmetry: Path, category_sizes: Path) -> Corpus:
+    room_df, arch, objs, inputs = load_rooms(rooms, architecture, objects)
+    room_df = room_df[room_df["room_type"].astype(str) == room_type]
+    ids = set(room_df["room_id"])
+    objs = objs[objs["room_id"].isin(ids)]
+    meshes, box_models = tables.read_meshes_of(models, objs["model_id"].dropna())
+    return Corpus(room_type, room_df, arch[arch["room_id"].isin(ids)], objs,
+                  {k: v for k, v in inputs.items() if k in ids}, read_split(split), list(models), symmetry,
+                  category_sizes, meshes, box_models)
+
+
+def load_generated(rooms: Path, architecture: Path, objects: Path, scenes: Path) -> Generated:
+    read = lambda path, schema: tables.read(path, schema).to_pandas()
+    return Generated(read(rooms, "rooms"), read(architecture, "architecture"), read(objects, "generated_objects"),
+                     read(scenes, "scenes"))

@@ -1,0 +1,120 @@
+"""The generation interface: every generator of this project is a *method*, a named pair of a graph generator (or
+none) and a layout generator, registered in one place (``pipeline.methods``).
+
+- A **graph generator** learns the relation graphs of a room type from the fit split's final graphs and samples
+  graphs for rooms' architectures, or completes a partial graph (:class:`GraphGenerator`). PlanIT's graph model is
+  one: its rules ``train_graph_model`` and ``sample_graphs`` write ``results/graph_model/<type>/sampled/``.
+- A **layout generator** places objects into rooms' architectures, from the graph generator's graphs or without
+  any (:class:`LayoutGenerator`): given a :class:`Task`, it yields one :class:`Scene` per room it generates. It
+  trains in rules of its own if it learns anything (PlanIT's placement networks: ``train_placement``).
+
+The ``generate`` rule runs one method for one room type (the ``method`` wildcard): it reads the corpus and the
+method's inputs, calls the layout generator, and writes its scenes as canonical tables (``methods/scenes.py``), so
+the evaluation and the report read every method's rooms the same way.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Iterator, Protocol
+
+import pandas as pd
+
+from ..room import RoomInput, Walls
+
+
+@dataclass
+class Corpus:
+    """What every method may read of one room type: the kept rooms (canonical rows and arrays), their split, the
+    model shards (meshes) and the symmetry and category-size tables of the corpus."""
+    room_type: str
+    rooms: pd.DataFrame
+    architecture: pd.DataFrame
+    objects: pd.DataFrame
+    inputs: dict[str, RoomInput]  # room id -> RoomInput with its real objects
+    split: dict[str, str]  # room id -> fit | validation | heldout
+    models: list[Path]
+    symmetry: Path
+    category_sizes: Path
+    meshes: dict = field(default_factory=dict)  # model id -> (vertices, faces) of the room type's objects
+    box_models: set = field(default_factory=set)  # models measured as their box
+
+    def ids(self, *parts: str) -> list[str]:
+        """Sorted ids of the kept rooms in the named parts of the split."""
+        return sorted(r for r, s in self.split.items() if s in parts and r in self.inputs)
+
+    def training(self) -> list[RoomInput]:
+        return [self.inputs[r] for r in self.ids("fit", "validation")]
+
+    def heldout(self) -> list[RoomInput]:
+        return [self.inputs[r] for r in self.ids("heldout")]
+
+
+@dataclass
+class Generated:
+    """Another method's generated rooms (a reference for methods that build on one, e.g. retrieval)."""
+    rooms: pd.DataFrame
+    architecture: pd.DataFrame
+    objects: pd.DataFrame
+    scenes: pd.DataFrame
+
+
+@dataclass
+class Task:
+    """One method's job for one room type: ``count`` scenes (None: the method's default)."""
+    config: dict
+    method: str
+    corpus: Corpus
+    graphs: tuple[Path, Path] | None = None  # (nodes, edges) of the method's graph generator
+    model: Path | None = None  # the trained networks the layout reads
+    reference: Generated | None = None
+    count: int | None = None
+    threads: int = 1  # CPU threads for the method's networks (the rule's threads)
+
+
+@dataclass
+class Scene:
+    """One generated room. ``room`` holds the placed objects (its room id is the scene id); ``record``: the
+    method's figures for the scenes table (search counts, consistency, ...); ``edges``: the planned graph drawn in
+    the scene's PNG; ``parents``: object id -> support parent id."""
+    scene_id: str
+    source_room_id: str
+    room: RoomInput
+    walls: Walls
+    status: str = "placed"
+    reason: str | None = None
+    record: dict = field(default_factory=dict)
+    edges: list = field(default_factory=list)
+    parents: dict = field(default_factory=dict)
+
+
+class LayoutGenerator(Protocol):
+    info: dict  # what the method's summary.json records besides its figures (e.g. PlanIT's variant settings)
+
+    def generate(self, task: Task) -> Iterator[Scene]:
+        """Yield the task's scenes, each in one of the corpus's room architectures."""
+
+
+class GraphGenerator(Protocol):
+    def fit(self, config: dict, graphs: list, split: dict[str, str], room_type: str, progress_file: Path,
+            threads: int = 1):
+        """Learn from the fit (and validation) graphs; return what the rule writes (checkpoint, history, summary)."""
+
+    def sample(self, config: dict, model: Path, graphs: list, room_type: str, spec: Path | None = None,
+               count: int | None = None) -> tuple[list[dict], list[dict], dict]:
+        """Graphs in held-out rooms' architectures (or completing ``spec``) as generated_nodes / generated_edges
+        rows, and a summary."""
+
+
+@dataclass(frozen=True)
+class Method:
+    """A named generator: a layout generator (``layout``: ``"module:factory"``, imported when the method runs;
+    ``factory(config, name)`` returns the :class:`LayoutGenerator`) and the inputs its rule gives it."""
+    name: str
+    layout: str
+    graphs: str | None = None  # the graph generator whose sampled graphs it places ("planit"), or None
+    model: str | None = None  # the placement networks it reads ("cfcn" | "fcn"), or None
+    reference: str | None = None  # the method whose rooms it reads, or None
+    keys: Callable[[dict, str], list[str]] = lambda config, name: ["seed"]  # the config keys it reads
+    scenes: Callable[[dict, str], int] | None = None  # scenes it generates by default (None: one per held-out room)
+    description: str = ""

@@ -1,0 +1,122 @@
+"""Sample relation graphs of one room type from PlanIT's trained graph model: from scratch in held-out rooms'
+architectures, or completing a partial graph given as a YAML spec. Invalid graphs are resampled (a budget); the ones
+still invalid are counted, never returned."""
+from __future__ import annotations
+
+import logging
+import zlib
+from collections import Counter
+from pathlib import Path
+
+import torch
+
+from .... import tables
+from ....errors import InputError
+from ....graphs import checks as graph_checks
+from ....graphs import data as graph_data
+from ....graphs.data import ARCH
+from ....learning import checkpoint
+from ....log import progress
+from . import train
+from .sampler import sample
+from .spec import load_spec
+from .tables import grown_rows
+
+log = logging.getLogger("planit.sample_graphs")
+
+
+def load_model(path: Path):
+    """The model file's record, vocabulary and rebuilt model (weights loaded, on the CPU, eval mode)."""
+    ckpt = checkpoint.load(path, train.KIND)
+    saved = ckpt.record
+    vocab = graph_data.Vocab(tuple(saved["categories"]))
+    model = train.build_model(vocab, saved["preset"])
+    model.load_state_dict(ckpt.state["model"])
+    model.eval()
+    return saved, vocab, model
+
+
+def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges: Path, room_type: str,
+                     spec: Path | None = None, count: int | None = None, threads: int = 1) -> tuple[list, list, dict]:
+    """``count`` (default ``graph_model.sample.graphs``) valid graphs as generated_nodes / generated_edges rows, and
+    a summary of the sampling; with ``spec``, graphs that complete that partial graph. ``graphs``: the room type's
+    final graphs (``nodes``, ``edges``: their tables, whose architecture rows the sampled graphs copy)."""
+    sc = config["graph_model"]["sample"]
+    torch.set_num_threads(threads)
+    saved, vocab, net = load_model(model)
+    by_id = {g.room_id: g for g in graphs}
+    held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
+    seen = {tuple(t) for t in saved["seen"]}
+    plan = None
+    if spec is not None:
+        plan, arch_from = load_spec(spec, room_type, vocab)
+        if arch_from and arch_from not in by_id:
+            raise InputError(f"{spec}: architecture.room: no room '{arch_from}' of type {room_type} in {nodes}")
+        held = [by_id[arch_from]] if arch_from else held
+        seen |= _plan_triples(plan)  # what the spec asks for is allowed, seen in training or not
+    if not held:
+        raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
+    n = count or sc["graphs"]
+    base_seed = zlib.crc32(f"{config['seed']}/{room_type}/{spec or ''}".encode())
+    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, saved["max_edges"], room_type)
+    rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type)
+    summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": n - len(kept),
+               "valid_before_rejection": round(first_try / max(n, 1), 4), "rejections": dict(reasons),
+               "temperature": sc["temperature"], "spec": str(spec) if spec else None}
+    log.info("%s", summary)
+    return rows_n, rows_e, summary
+
+
+def _plan_triples(plan) -> set[tuple[int, int, int]]:
+    cls = [len(ARCH) + c for c, _, _ in plan.objects]
+    return {(cls[k], cls[j], c) if d == 0 else (cls[j], cls[k], c) for k, d, c, j in plan.edges}
+
+
+def _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, max_edges, room_type) -> tuple[dict, int, Counter]:
+    """Graph index -> (valid graph, seed); how many were valid at the first try; rejections by reason. A graph that
+    fails the checks is sampled again, up to ``resample_budget`` times."""
+    kept, first_try, reasons = {}, 0, Counter()
+    pending = list(range(n))
+    for attempt in range(sc["resample_budget"] + 1):
+        for k in progress(range(0, len(pending), sc["batch_size"]), desc=f"sample {room_type}, try {attempt + 1}"):
+            part = pending[k:k + sc["batch_size"]]
+            seed = base_seed + 1_000_003 * attempt + k
+            grown = sample(net, vocab, [held[i % len(held)] for i in part], seed, sc["temperature"], sc["max_objects"],
+                           max_edges, [plan] * len(part) if plan else None, seen)
+            for i, g in zip(part, grown):
+                bad = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen)
+                reasons.update(bad)
+                first_try += attempt == 0 and not bad
+                if not bad:
+                    kept[i] = (g, seed)
+        pending = [i for i in pending if i not in kept]
+        if not pending:
+            break
+    return kept, first_try, reasons
+
+
+def graph_rows(kept: dict, vocab, nodes: Path, edges: Path, room_type: str) -> tuple[list[dict], list[dict]]:
+    """The kept graphs as generated_nodes / generated_edges rows, architecture copied from their rooms."""
+    flt = [("room_type", "=", room_type)]
+    arch_rows = _architecture_rows(tables.read(nodes, "final_nodes", filters=flt).to_pandas(),
+                                   tables.read(edges, "final_edges", filters=flt).to_pandas())
+    rows_n, rows_e = [], []
+    for i in sorted(kept):
+        g, seed = kept[i]
+        an, ae = arch_rows[g.arch.room_id]
+        nn_, ee = grown_rows(g, vocab, an, ae, f"gen_{room_type}_{i:05d}", room_type, seed)
+        rows_n += nn_
+        rows_e += ee
+    return rows_n, rows_e
+
+
+def _architecture_rows(node_df, edge_df) -> dict:
+    """Per room: its architecture node rows (in the graph's order) and its kept architecture edges."""
+    out = {}
+    arch_e = edge_df[edge_df["edge_type"].astype(str).isin(["wall_adjacent", "wall_opposite", "opening"])
+                     & (edge_df["status"].astype(str) == "kept")]
+    by_room = dict(tuple(arch_e.groupby("room_id", sort=False)))
+    for room, g in node_df[node_df["kind"].astype(str) != "object"].groupby("room_id", sort=False):
+        out[room] = (g.sort_values("node_id"), by_room.get(room, arch_e.iloc[:0]))
+    return out
+

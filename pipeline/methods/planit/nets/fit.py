@@ -1,0 +1,94 @@
+"""Fit PlanIT's placement networks (location CFCN + orientation) of one room type on its training rooms (fit and
+validation splits; the held-out rooms are never trained on); ``net="fcn"`` trains the unconditional FCN of the
+ablation."""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+import torch
+
+from ....config import config_hash
+from ....errors import InputError
+from ....learning.checkpoint import Checkpoint
+from ....learning.device import pick_device
+from ....log import progress
+from . import train as nets_train
+from .data import TrainingRoom, training_room
+
+log = logging.getLogger("planit.train_placement")
+NETS = ("cfcn", "fcn")
+
+
+@dataclass
+class Fitted:
+    checkpoint: Checkpoint
+    history: pd.DataFrame
+    summary: dict
+    curve: object  # matplotlib figure
+
+
+def training_rooms(inputs: dict, node_df: pd.DataFrame, edge_df: pd.DataFrame, split: dict[str, str]):
+    """Categories, training and held-out :class:`TrainingRoom` lists, and the held-out ids, of one room type's
+    rooms (``inputs``: room id -> RoomInput) and final graphs."""
+    ids = sorted(node_df["room_id"].unique())
+    train_ids = [i for i in ids if split.get(i) in ("fit", "validation")]
+    held_ids = [i for i in ids if split.get(i) == "heldout"]
+    cats = tuple(sorted({c for i in ids if i in inputs for c in inputs[i].categories}))
+    by_room_n, by_room_e = dict(tuple(node_df.groupby("room_id"))), dict(tuple(edge_df.groupby("room_id")))
+    make = lambda i: training_room(inputs[i], by_room_n[i], by_room_e.get(i, edge_df.iloc[:0]))
+    return cats, [make(i) for i in train_ids if i in inputs], [make(i) for i in held_ids if i in inputs], held_ids
+
+
+def fit_room_type(config: dict, room_type: str, net: str, cats: tuple, train_rooms: list[TrainingRoom],
+                  held_rooms: list[TrainingRoom], held_ids: list[str], progress_file: Path, threads: int = 1) -> Fitted:
+    """Train for the preset's steps; ``progress_file`` resumes an interrupted run with the same settings."""
+    if net not in NETS:
+        raise InputError(f"--net: '{net}' is not one of {', '.join(NETS)}")
+    if not train_rooms:
+        raise InputError(f"room type '{room_type}' has no training room")
+    pc = config["placement"]
+    preset = pc["presets"][pc["preset"]]
+    torch.set_num_threads(threads)
+    device = pick_device(pc["device"])
+    chash = config_hash({"preset": preset, "net": net, "seed": config["seed"], "room_type": room_type,
+                         "rooms": sorted(t.room.room_id for t in train_rooms), "categories": cats})
+    nets, history = nets_train.train(train_rooms, held_rooms, cats, preset, net == "cfcn", config["seed"],
+                                     progress_file, chash, device, _ticker(room_type, net, preset))
+    ckpt = Checkpoint(nets_train.KIND, chash, {"nets": [n.cpu().state_dict() for n in nets]}, {
+        "room_type": room_type, "net": net, "categories": list(cats), "preset": preset, "heldout_ids": held_ids})
+    frame = pd.DataFrame(history)
+    summary = {"room_type": room_type, "net": net, "preset": pc["preset"], "device": device,
+               "train_rooms": len(train_rooms), "heldout_rooms": len(held_rooms), "steps": int(frame["step"].iloc[-1]),
+               "train_seconds": round(float(frame["seconds"].iloc[-1]), 1),
+               "final_heldout_location_loss": round(float(frame["heldout_location_loss"].iloc[-1]), 4),
+               "final_heldout_orientation_loss": round(float(frame["heldout_orientation_loss"].iloc[-1]), 4)}
+    return Fitted(ckpt, frame, summary, _curve(frame, room_type, net))
+
+
+def _ticker(room_type: str, net: str, preset: dict):
+    bar = iter(progress(range(preset["steps"] // preset["log_every"] + 1), desc=f"train placement {room_type} ({net})"))
+
+    def tick(step, row):
+        next(bar, None)
+        log.info("step %d: location %.3f (held-out %.3f), orientation %.3f (held-out %.3f)", step, row["location_loss"],
+                 row["heldout_location_loss"], row["orientation_loss"], row["heldout_orientation_loss"])
+    return tick
+
+
+def _curve(history, room_type: str, net: str):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))
+    for ax, name in zip(axes, ("location", "orientation")):
+        ax.plot(history["step"], history[f"{name}_loss"], label="train")
+        ax.plot(history["step"], history[f"heldout_{name}_loss"], label="held-out")
+        ax.set(xlabel="step", ylabel="loss", title=f"{name}, {room_type} ({net})")
+        ax.legend()
+    fig.tight_layout()
+    return fig

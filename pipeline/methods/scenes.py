@@ -1,0 +1,116 @@
+"""Generated rooms as canonical tables (every stage reads them unchanged), one record per scene (failed ones
+included, with their reason), and per scene a GLB, a top-down PNG with the planned graph and a JSON summary: the one
+writer of every method's rooms."""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from .. import tables
+from ..placement import export
+from .interface import Corpus, Scene
+
+log = logging.getLogger("planit.generate")
+SCORED = ("placed", "partial")  # scenes whose rooms are scored (failed ones are counted, not scored)
+OBJECT_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
+
+
+@dataclass
+class Rows:
+    """The tables of a method's scenes, gathered scene by scene."""
+    records: list[dict] = field(default_factory=list)
+    rooms: list[dict] = field(default_factory=list)
+    architecture: list[dict] = field(default_factory=list)
+    objects: list[dict] = field(default_factory=list)
+
+    def add(self, scene: Scene, corpus: Corpus, method: str) -> dict:
+        """Add one scene's rows (its room id is the scene id); returns its record."""
+        room = scene.room
+        record = {"scene_id": scene.scene_id, "room_type": corpus.room_type, "variant": method,
+                  "source_room_id": scene.source_room_id, "status": scene.status, "reason": scene.reason,
+                  "planned_objects": len(room.object_ids), "placed_objects": len(room.object_ids), **scene.record}
+        src = tables.records(corpus.rooms[corpus.rooms["room_id"] == scene.source_room_id])[0]
+        self.records.append(record)
+        self.rooms.append({**src, "room_id": scene.scene_id, "n_objects": len(room.object_ids), "shard": 0})
+        arch = corpus.architecture[corpus.architecture["room_id"] == scene.source_room_id]
+        self.architecture += tables.records(arch.assign(room_id=scene.scene_id))
+        self.objects += [{"room_id": scene.scene_id, "scene_id": scene.scene_id, "object_id": o, "category": c,
+                          "model_id": m, **dict(zip(OBJECT_COLUMNS, map(float, b))),
+                          **dict(zip(["px", "py", "pz", "_yaw", "sx", "sy", "sz"], map(float, p))),
+                          "source_parent_id": scene.parents.get(o)}
+                         for o, c, m, b, p in zip(room.object_ids, room.categories, room.model_ids, room.boxes,
+                                                  room.poses)]
+        return record
+
+
+def write_scene_files(folder: Path, scene: Scene, record: dict, mesh_of) -> None:
+    """The scene's GLB, top-down PNG (with its planned graph) and JSON record."""
+    folder.mkdir(parents=True, exist_ok=True)
+    export.write_glb(folder / f"{scene.scene_id}.glb", scene.room, scene.walls, mesh_of)
+    consistency = record.get("consistency")
+    title = f"{scene.scene_id} ({record['status']}" + (
+        f", consistency {consistency:.2f})" if consistency is not None else ")")
+    tables.write_figure(folder / f"{scene.scene_id}.png", export.plan_figure(scene.room, scene.walls, scene.edges, title))
+    tables.write_json(folder / f"{scene.scene_id}.json", record)
+
+
+def write_tables(rows: Rows, corpus: Corpus, out) -> pd.DataFrame:
+    """The canonical tables, the scenes table and the used models (``out``: rooms, architecture, objects, models,
+    scenes); returns the scenes as a frame."""
+    objs = pd.DataFrame(rows.objects, columns=[*tables.SCHEMAS["generated_objects"].names, "_yaw"]).drop(columns="_yaw")
+    used = set(objs["model_id"])
+    tables.write(out.rooms, "rooms", tables.from_rows("rooms", rows.rooms))
+    tables.write(out.architecture, "architecture", tables.from_rows("architecture", rows.architecture))
+    tables.write(out.objects, "generated_objects", tables.from_rows("generated_objects", tables.records(objs)))
+    model_rows = pd.concat([tables.read(p, "models", filters=[("model_id", "in", sorted(used))]).to_pandas()
+                            for p in (corpus.models if used else [])] + [tables.empty("models").to_pandas()])
+    tables.write(out.models, "models", tables.from_rows("models", tables.records(model_rows.drop_duplicates("model_id"))))
+    Path(out.files).mkdir(parents=True, exist_ok=True)
+    tables.write(out.scenes, "scenes", tables.from_rows("scenes", rows.records))
+    return pd.DataFrame(rows.records, columns=tables.SCHEMAS["scenes"].names)
+
+
+def summarise(scenes: pd.DataFrame) -> dict:
+    """Table 3's figures over a method's scenes (violation and consistency over the placed and partial ones)."""
+    if scenes.empty:
+        return {"scenes": 0, "placed": 0, "partial": 0, "failed": 0}
+    scored = scenes["status"].isin(SCORED)
+    mean = lambda col: round(float(scenes.loc[scored, col].mean()), 4) if scored.any() and scenes[col].notna().any() else None
+    total = lambda col: scenes[col].fillna(0).sum()
+    return {"scenes": int(len(scenes)), "placed": int((scenes["status"] == "placed").sum()),
+            "partial": int((scenes["status"] == "partial").sum()), "failed": int((~scored).sum()),
+            "restarted": int((scenes["attempts"].fillna(1) > 1).sum()),
+            "rejections_per_scene": _round(scenes["rejections"].mean(), 3),
+            "backtracks_per_insertion": _round(total("backtracks") / max(total("insertions"), 1), 4),
+            "violation": mean("violation"), "consistency": mean("consistency"),
+            "collision_rate": _round(total("colliding_objects") / max(total("placed_objects"), 1), 4),
+            "median_seconds": _round(scenes["seconds"].median(), 3),
+            "unplanned_adjacent_per_scene": _round(scenes["unplanned_adjacent"].mean(), 3)}
+
+
+def _round(value, digits: int):
+    return None if pd.isna(value) else round(float(value), digits)
+
+
+def write_generated(scenes, corpus: Corpus, method: str, out, meshes: dict, desc: str = "") -> dict:
+    """Write every scene of ``scenes`` (an iterator, consumed here) and the method's tables; returns the summary
+    (``out``: rooms, architecture, objects, models, scenes, summary, files)."""
+    rows = Rows()
+    for scene in scenes:
+        record = rows.add(scene, corpus, method)
+        if scene.status != "placed":
+            log.warning("scene %s %s: %s", scene.scene_id, scene.status, scene.reason)
+        write_scene_files(Path(out.files), scene, record, meshes.get)
+    frame = write_tables(rows, corpus, out)
+    return summarise(frame)
+
+
+def generate_rooms(layout, name: str, task, out) -> dict:
+    """Run a layout generator on a task and write everything (``out``: the generated tables, ``summary``, ``files``):
+    what the ``generate`` and ``instantiate`` stages share."""
+    summary = write_generated(layout.generate(task), task.corpus, name, out, task.corpus.meshes)
+    tables.write_json(out.summary, {"room_type": task.corpus.room_type, "variant": name, **layout.info, **summary})
+    return summary
