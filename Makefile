@@ -30,6 +30,7 @@ browser:
 	else echo "chromium not installed and not installable here: the report's browser test will skip"; fi
 
 test: setup browser
+	$(BIN)/lint-imports
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest -q -ra -n 2 --dist loadgroup
 
 test-slurm: setup

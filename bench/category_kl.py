@@ -22,7 +22,10 @@ from pipeline.stage import Files
 from pipeline import config as config_mod
 from pipeline import tables
 from pipeline.evaluation import distributions
-from pipeline.stages import evaluate, sample_graphs
+from pipeline.evaluation import scores as evaluate_scores
+from pipeline.evaluation.sets import load_real
+from pipeline.graphs.load import read_split
+from pipeline.stages import sample_graphs
 
 from common import ROOT, arguments, report
 
@@ -53,14 +56,14 @@ def graph_categories(nodes: Path, rooms: set[str] | None = None) -> list[list[st
 
 def one_type(cfg: dict, run: Path, room_type: str, graphs: int, tmp: Path) -> dict:
     eps = cfg["evaluate"]["kl_eps"]
-    train, real = evaluate.load_real(cfg, room_type, shards(run, "results/filter/shards/rooms-*.parquet"),
-                                     shards(run, "results/ingest/shards/architecture-*.parquet"),
-                                     shards(run, "results/ingest/shards/objects-*.parquet"),
-                                     run / "results" / "graphs" / "ingested" / "nodes.parquet")
+    train, real = load_real(room_type, read_split(run / "results" / "splits" / f"{room_type}.parquet"),
+                            shards(run, "results/filter/shards/rooms-*.parquet"),
+                            shards(run, "results/ingest/shards/architecture-*.parquet"),
+                            shards(run, "results/ingest/shards/objects-*.parquet"))
     p = distributions.flatten([r.categories for r in real.rooms])
     rooms, summary = sampled_categories(cfg, run, room_type, graphs, tmp)
     kl = lambda rs: round(distributions.category_kl(p, distributions.flatten(rs), eps), 5)
-    floor = evaluate.floors(train, real, len(rooms), cfg["evaluate"], cfg["seed"])["category_kl"]
+    floor = evaluate_scores.floors(train, real, len(rooms), cfg["evaluate"], cfg["seed"])["category_kl"]
     value = kl(rooms)
     out = {"heldout_rooms": len(real.rooms), "sampled_graphs": len(rooms), "category_kl": value, "floor": floor,
            "goal_kl_le_0.01": value <= 0.01, "sampler": {k: summary[k] for k in ("written", "failed_after_budget")}}

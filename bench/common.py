@@ -89,7 +89,7 @@ def corpus_paths(config: dict) -> dict:
     if not all(p.exists() for p in rooms):
         raise SystemExit(f"{rooms[0].parent}: the filter's {config['shards']} shard(s) are not all there; run the "
                          "pipeline first, or give the config it ran with (--config; default config/config.yaml)")
-    return {"rooms": rooms,
+    return {"rooms": rooms, "splits": Path("results/splits"),
             **{t: [Path(f"results/ingest/shards/{t}-{k}.parquet") for k in shards] for t in ("architecture", "objects", "models")},
             "symmetry": Path("results/graphs/ingested/symmetry.parquet"),
             "category_sizes": Path("results/graphs/ingested/stats/category_sizes.parquet")}

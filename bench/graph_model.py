@@ -23,7 +23,7 @@ from pipeline.graphs import data as graph_data
 from pipeline.methods.planit.graph_model import sampler
 from pipeline.methods.planit.graph_model import train
 from pipeline.methods.planit.graph_model.teacher import make_batch, nll
-from pipeline.stages.train_graph_model import room_graphs
+from pipeline.graphs.load import room_graphs
 
 from common import ROOT, arguments, report
 
@@ -71,7 +71,7 @@ def main() -> None:
     seen = graph_checks.seen_triples(graphs)
     trained = ROOT / "results" / "graph_model" / args.room_type / "model.pt"
     if trained.exists():  # sample from the trained model (an untrained one stops at random lengths)
-        from pipeline.stages.sample_graphs import load_model
+        from pipeline.methods.planit.graph_model.sample import load_model
 
         _, vocab, model = load_model(trained)
     model.eval()

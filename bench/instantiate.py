@@ -34,18 +34,29 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement import scene_metrics
 from pipeline.placement.proposers import FaceAway
 from pipeline.placement.search import Grid, anchors_of
-from pipeline.stages import instantiate, train_placement
+from pipeline import tables
+from pipeline.methods.corpus import load_corpus
+from pipeline.methods.planit import layout as instantiate
+from pipeline.methods.planit.nets.fit import training_rooms
 
 from common import ROOT, arguments, corpus_paths, report, search_flags, search_overrides, search_suffix
+
+
+def corpus_of(cfg: dict, room_type: str):
+    """The kept rooms of a room type as every method reads them (the default run's outputs)."""
+    p = corpus_paths(cfg)
+    return load_corpus(room_type, p["rooms"], p["architecture"], p["objects"], p["models"],
+                       p["splits"] / f"{room_type}.parquet", p["symmetry"], p["category_sizes"])
 
 
 def probe_networks(cfg, room_type: str, saved: dict, probes: int, checker) -> dict:
     """On held-out rooms, remove one object at a time and ask the networks for it; and the held-out real rooms'
     collision rate (objects penetrating another deeper than the search allows, same measure)."""
-    p = corpus_paths(cfg)
-    _, _, held, _ = train_placement.training_rooms(cfg, room_type, p["rooms"], p["architecture"], p["objects"],
-                                                   ROOT / "results/graphs/ingested/nodes.parquet",
-                                                   ROOT / "results/graphs/ingested/edges.parquet")
+    corpus = corpus_of(cfg, room_type)
+    flt = [("room_type", "=", room_type)]
+    nodes = tables.read(ROOT / "results/graphs/ingested/nodes.parquet", "final_nodes", filters=flt).to_pandas()
+    edges = tables.read(ROOT / "results/graphs/ingested/edges.parquet", "final_edges", filters=flt).to_pandas()
+    _, _, held, _ = training_rooms(corpus.inputs, nodes, edges, corpus.split)
     net, rng = NetProposer(saved, cfg["instantiate"]["density_cache"]), np.random.default_rng(0)
     near, net_hits, rule_hits, n = [], 0, 0, 0
     for t in (held[int(rng.integers(len(held)))] for _ in range(probes)):
@@ -98,14 +109,12 @@ def main() -> None:
     if args.density_cache:
         cfg["instantiate"]["density_cache"] = args.density_cache
     saved = checkpoint.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", "placement_nets")
-    p = corpus_paths(cfg)
-    ctx = instantiate.load_context(cfg, args.room_type, saved, p["rooms"], p["architecture"], p["objects"], p["models"],
-                                   p["symmetry"], p["category_sizes"])
+    ctx = instantiate.load_context(cfg, corpus_of(cfg, args.room_type))
     if args.no_confirm:
         ctx.checker.cfg["confirm"] = None
     variant = cfg["instantiate"]["variants"]["planit"]
     graphs = ROOT / "results/graph_model" / args.room_type / "sampled"
-    plans = instantiate.select_plans(cfg, variant, ctx, graphs / "nodes.parquet", graphs / "edges.parquet", args.scenes)
+    plans = instantiate.select_plans(cfg, variant, ctx.corpus, graphs / "nodes.parquet", graphs / "edges.parquet", args.scenes)
     proposer = instantiate.make_proposer("cfcn", saved, cfg["instantiate"])
     nets = getattr(proposer, "base", proposer)  # the NetProposer, under the relation bands when they are on
     rows, colliding, ev = [], 0, {**cfg["evaluate"]["collision"], "intersector": ctx.checker.intersector}

@@ -129,7 +129,7 @@ def test_every_shipped_config_validates_over_the_defaults(name):
 
 
 def test_default_run_places_100_rooms_per_type_and_caps_the_baselines_at_30():
-    from pipeline.stages.instantiate import scene_count
+    from pipeline.methods.planit.layout import scene_count
 
     ic = config.load(ROOT / "config" / "config.yaml")["instantiate"]
     counts = {name: scene_count(ic, v) for name, v in ic["variants"].items()}

@@ -186,7 +186,7 @@ def test_generator_rules_read_an_extracted_room():
     """A bed against a wall between two nightstands, a lamp on one: the procedural rules hold on its extracted graph;
     the bed pulled off the wall breaks 'against_wall'."""
     from pipeline.corpus.procedural_rules import satisfaction
-    from pipeline.stages.evaluate import rule_view
+    from pipeline.evaluation.scores import rule_view
 
     def bedroom(bed_y):
         room = Room(SQUARE).add("bed", "bed", (1.6, 2.0, 0.5), (2.0, bed_y), 180)

@@ -245,12 +245,15 @@ def test_batched_training_matches_one_graph_at_a_time(bedrooms):
 def test_early_stopping_sees_validation_rooms_never_the_held_out_test_rooms():
     """The graph model picks its epoch on training rooms held back from fitting; the held-out rooms it is evaluated
     on (the same split the placement training and the evaluation use) take no part."""
-    from pipeline.stages.train_graph_model import splits
-
     ids = [f"room_{k:03d}" for k in range(200)]
     gm = config.validate({})["graph_model"]
-    fit, val, held = splits(ids, gm, seed=0)
+
+    def splits(seed):
+        split = graph_data.room_splits(ids, gm["heldout_fraction"], gm["validation_fraction"], seed)
+        return tuple(sorted(r for r, s in split.items() if s == part) for part in graph_data.SPLITS)
+
+    fit, val, held = splits(0)
     assert sorted(fit + val + held) == ids and not (set(fit) & set(val)) and not (set(fit + val) & set(held))
     assert (len(held), len(val)) == (30, 17)  # 0.15 of 200, then 0.1 of the 170 left
     assert held == graph_data.split_heldout(ids, gm["heldout_fraction"], 0)[1]
-    assert splits(ids, gm, seed=0) == (fit, val, held) and splits(ids, gm, seed=1)[1] != val
+    assert splits(0) == (fit, val, held) and splits(1)[1] != val

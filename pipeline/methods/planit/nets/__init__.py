@@ -1,0 +1,1 @@
+"""PlanIT's placement networks (paper section 6): the location CFCN (or unconditional FCN) and the orientation network."""
