@@ -22,5 +22,5 @@ include: "rules/evaluate.smk"
 
 rule all:
     input:
-        get_final_outputs(),
+        get_final_outputs,
     default_target: True

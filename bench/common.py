@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.stage import Files
 from pipeline import config as config_mod
 
@@ -71,7 +72,7 @@ def ingest_and_filter(cfg: dict, p: dict[str, Path]) -> tuple[dict, object, floa
     from pipeline.stages import filter_rooms, ingest, ingest_summary
 
     t = time.perf_counter()
-    counts = ingest.run(cfg, Files(), Files({n: p[n] for n in ingest.OUTPUTS}), shard=0)
+    counts = ingest.run(cfg, Files(), Files({n: p[n] for n in INGEST_OUTPUTS}), shard=0)
     ingest_summary.run(cfg, Files(rooms=[p["rooms"]], objects=[p["objects"]], models=[p["models"]],
                                   reports=[p["ingest_report"]], drops=[p["drops"]]),
                        Files(counts=p["counts"], report=p["summary"], drops=p["all_drops"]))

@@ -14,6 +14,8 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline import config as config_mod
+from pipeline.corpus.ingest import OUTPUTS
+from pipeline.stage import Files
 from pipeline.stages import ingest
 
 from common import OUT, ROOT, arguments, report
@@ -33,7 +35,7 @@ def main() -> None:
     times = []
     for _ in range(args.repeat):
         t = time.perf_counter()
-        counts = ingest.run(cfg, 0, {n: args.workdir / "ingest" / f"{n}.parquet" for n in ingest.OUTPUTS})
+        counts = ingest.run(cfg, Files(), Files({n: args.workdir / "ingest" / f"{n}.parquet" for n in OUTPUTS}), shard=0)
         times.append(time.perf_counter() - t)
     warm = statistics.median(times[1:])
     rep = pd.read_parquet(args.workdir / "ingest" / "ingest_report.parquet")

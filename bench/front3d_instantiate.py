@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.stage import Files
 from pipeline import config as config_mod
 from pipeline import tables
@@ -33,7 +34,7 @@ def main() -> None:
         "houses": str(args.sample / "houses"), "future": str(args.sample / "3d-future"), "cache_dir": str(w / "cache")},
         "instantiate": search_overrides(args)})
     ing = w / "ingest"
-    outs = {t: ing / f"{t}-0.parquet" for t in ingest.OUTPUTS}
+    outs = {t: ing / f"{t}-0.parquet" for t in INGEST_OUTPUTS}
     ingest.run(cfg, Files(), Files(outs), shard=0)
     symmetry.run(cfg, Files(models=[outs["models"]]), Files(table=w / "sym.parquet", agreement=w / "sym.json"))
     extract_graphs.run(cfg, Files(rooms=outs["rooms"], architecture=outs["architecture"], objects=outs["objects"],

@@ -129,3 +129,13 @@ def restrict(config: dict, shape: dict) -> dict:
 def config_hash(section: Any) -> str:
     """Short stable hash of a config section, stored in every output table's metadata."""
     return hashlib.sha256(json.dumps(section, sort_keys=True).encode()).hexdigest()[:12]
+
+
+def candidate_room_types(config: dict) -> list[str]:
+    """Room types to learn: ``graph_model.room_types``; else, for the procedural corpus, the types it builds rooms
+    of; else every type the filter knows. A type whose rooms are too few is skipped by the ``room_types`` rule."""
+    if config["graph_model"]["room_types"]:
+        return list(config["graph_model"]["room_types"])
+    if config["source"] == "procedural":
+        return [t for t, n in config["procedural"]["rooms"].items() if n > 0]
+    return list(config["filter"]["min_floor_objects"])

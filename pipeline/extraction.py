@@ -57,12 +57,7 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, 
     models = [room.model_ids[k] for k in keep]
     b = room.boxes[keep].reshape(-1, 7)
     n, n_walls = len(ids), len(walls.ids)
-    obj_fp, wall_fp = relations.footprints(b), wall_footprints(walls)
-    all_fp = np.concatenate([obj_fp, wall_fp])
-    plan = meshes.prisms(all_fp, *PLAN_Z)
-    per_prism = meshes.faces_per_prism(4)
-    scene = RoomScene(parts + [plan], list(range(n)) + [0], [MESH] * n + [PLAN], intersector)
-    scene.owner[-len(plan[1]):] = np.repeat(np.arange(n + n_walls), per_prism)  # one owner per prism
+    scene, all_fp = _room_scene(parts, b, walls, intersector)
 
     # support first (the sweep's groups depend on tiers), then the visibility sweep of every anchor side
     boxy = np.array([box_models is None or m in box_models for m in models], bool)
@@ -75,15 +70,7 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, 
     g.hanging = int(hanging.sum())
     sym = [symmetry_of(c, m) for c, m in zip(cats, models)]
     drop = hanging if cfg["support"]["hanging"] == "drop" else np.zeros(n, bool)
-    for k in np.flatnonzero(drop):
-        g.skipped.append((ids[k], "hanging: nothing below it and its bottom high above the floor"))
-    for k in np.flatnonzero(~drop):
-        g.nodes.append({"room_id": room.room_id, "node_id": ids[k], "kind": "object", "category": cats[k],
-                        "model_id": models[k], "symmetry": sym[k][0], "symmetry_origin": sym[k][1], "tier": int(tier[k]),
-                        "parent_id": ids[parent[k]] if parent[k] >= 0 else None,
-                        **dict(zip(BOX_COLUMNS, map(float, b[k]))), "length": None})
-        if parent[k] >= 0:
-            g.edges.append(_edge(room.room_id, ids[parent[k]], ids[k], "support", support_area=float(area[k])))
+    _object_nodes(g, room.room_id, (ids, cats, models, sym), b, (parent, area, tier), drop)
     _wall_nodes(g, room.room_id, walls)
     radial = np.array([s[0] == "radial" for s in sym], bool)
     # who sees whom: the floor plan (group 0), the objects on one parent (parent + 1); hanging objects none
@@ -93,6 +80,33 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, 
     g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg, anchors)
     _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
     return g
+
+
+def _room_scene(parts: list, b: np.ndarray, walls: Walls, intersector) -> tuple[RoomScene, np.ndarray]:
+    """The room's ray scene (the objects' meshes, and the plan layer's prisms over every object's and wall's
+    footprint, one owner per prism) and those footprints ``(n + w, 4, 2)``."""
+    n = len(b)
+    all_fp = np.concatenate([relations.footprints(b), wall_footprints(walls)])
+    plan = meshes.prisms(all_fp, *PLAN_Z)
+    scene = RoomScene(parts + [plan], list(range(n)) + [0], [MESH] * n + [PLAN], intersector)
+    scene.owner[-len(plan[1]):] = np.repeat(np.arange(n + len(walls.ids)), meshes.faces_per_prism(4))
+    return scene, all_fp
+
+
+def _object_nodes(g: RoomGraph, room_id: str, named: tuple, b: np.ndarray, support: tuple, drop: np.ndarray) -> None:
+    """Object nodes and their support edges (``named``: ids, categories, models, symmetries; ``support``: parent
+    index, support area, tier per object); objects in ``drop`` are skipped with the reason."""
+    ids, cats, models, sym = named
+    parent, area, tier = support
+    for k in np.flatnonzero(drop):
+        g.skipped.append((ids[k], "hanging: nothing below it and its bottom high above the floor"))
+    for k in np.flatnonzero(~drop):
+        g.nodes.append({"room_id": room_id, "node_id": ids[k], "kind": "object", "category": cats[k],
+                        "model_id": models[k], "symmetry": sym[k][0], "symmetry_origin": sym[k][1], "tier": int(tier[k]),
+                        "parent_id": ids[parent[k]] if parent[k] >= 0 else None,
+                        **dict(zip(BOX_COLUMNS, map(float, b[k]))), "length": None})
+        if parent[k] >= 0:
+            g.edges.append(_edge(room_id, ids[parent[k]], ids[k], "support", support_area=float(area[k])))
 
 
 def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: float,

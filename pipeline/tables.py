@@ -446,11 +446,27 @@ def read(path: str | Path, name: str | None = None, filters=None, columns: list[
         check(path, name)
     try:
         wanted = columns if columns is not None else (SCHEMAS[name].names if name is not None else None)
-        return pq.read_table(path, filters=filters, columns=wanted)
+        return pq.read_table(path, filters=_typed(filters, path), columns=wanted)
     except FileNotFoundError as exc:
         raise TableError(f"{path}: no such table file{_made_by(name)}") from exc
     except (pa.ArrowInvalid, OSError) as exc:
         raise TableError(f"{path}: not a readable Parquet file{_made_by(name)}: {exc}") from exc
+
+
+def _typed(filters, path):
+    """Filters whose ``in`` lists carry their column's type: an empty list (a shard with no rooms) is then a valid
+    filter that matches nothing, where pyarrow cannot infer the type of ``[]``."""
+    if not filters or not any(isinstance(f, tuple) and f[1] in ("in", "not in") for f in filters):
+        return filters
+    schema = pq.read_schema(path)
+    out = []
+    for f in filters:
+        if isinstance(f, tuple) and f[1] in ("in", "not in") and f[0] in schema.names:
+            kind = schema.field(f[0]).type
+            kind = kind.value_type if pa.types.is_dictionary(kind) else kind
+            f = (f[0], f[1], pa.array(list(f[2]), type=kind))
+        out.append(f)
+    return out
 
 
 def check(path: str | Path, name: str) -> None:

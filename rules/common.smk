@@ -74,6 +74,7 @@ ABLATION = "results/generated/{room_type}/{variant}/{name}"  # Table 3's variant
 TABLE3 = "results/generated/{room_type}/table3.csv"
 EVAL = "results/eval/{room_type}/{name}"
 SPLIT = "results/splits/{room_type}.parquet"
+ROOM_TYPES = "results/graphs/ingested/room_types.csv"
 RUNTIME = "results/runtime.csv"
 METHODS = config["generation"]["methods"]
 VARIANTS = config["instantiate"]["variants"]
@@ -165,13 +166,12 @@ def get_corpus_ground_truth(wildcards):
 
 
 def graph_room_types():
-    """Room types with a graph model: graph_model.room_types; else, for the procedural corpus, the types it builds
-    rooms of; else every type the filter knows."""
-    if config["graph_model"]["room_types"]:
-        return config["graph_model"]["room_types"]
-    if config["source"] == "procedural":
-        return [t for t, n in config["procedural"]["rooms"].items() if n > 0]
-    return list(config["filter"]["min_floor_objects"])
+    """The room types learned: the candidates (graph_model.room_types, else the corpus's) that the room_types
+    checkpoint kept; the others are skipped with their reason in its table (and the report)."""
+    import csv
+
+    with open(checkpoints.room_types.get().output.table) as f:
+        return [r["room_type"] for r in csv.DictReader(f) if r["status"] == "learned"]
 
 
 def get_method_inputs(wildcards):
@@ -195,12 +195,12 @@ def get_ablation_model(wildcards):
     return PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")
 
 
-def get_final_outputs():
+def get_final_outputs(wildcards):
     """Every output of the default run; the run-time table last, built once all the others exist."""
-    return [*pipeline_outputs(), RUNTIME]
+    return [*pipeline_outputs(wildcards), RUNTIME]
 
 
-def pipeline_outputs():
+def pipeline_outputs(wildcards):
     types = graph_room_types()
     return [
         *expand(GRAPH_MODEL, room_type=types, name=["metrics.json", "loss.png"]),
@@ -208,6 +208,7 @@ def pipeline_outputs():
         *expand(GENERATED, room_type=types, method=METHODS, name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
         *expand(EVAL, room_type=types, name="metrics.json"),
+        ROOM_TYPES,
         FILTER_REPORT,
         INGEST_REPORT,
         DROPS,

@@ -42,7 +42,7 @@ rule evaluate:
 
 rule runtime:
     input:
-        done=pipeline_outputs(),
+        done=pipeline_outputs,
     output:
         table=report(RUNTIME, caption="../report/runtime.rst", category="7. Run time"),
     params:

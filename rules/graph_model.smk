@@ -3,6 +3,24 @@
 # room type's rooms is written once (split_rooms) and read by every learner, method and the evaluation.
 
 
+checkpoint room_types:
+    input:
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+    output:
+        table=report(ROOM_TYPES, caption="../report/room_types.rst", category="2. Graphs"),
+    params:
+        config=keys("graph_model.room_types", "source", "procedural.rooms", "filter.min_floor_objects"),
+        io=stage_io("room_types"),
+    log:
+        "logs/room_types/room_types.log",
+    benchmark:
+        "benchmarks/room_types/room_types.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
+
+
 rule split_rooms:
     input:
         nodes=GATHERED.format(corpus="ingested", table="nodes"),

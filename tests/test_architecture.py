@@ -13,14 +13,14 @@ from conftest import ROOT
 
 PKG = ROOT / "pipeline"
 BIN = Path(sys.executable).parent
-RULE = re.compile(r"^rule (\w+):", re.M)
+RULE = re.compile(r"^(?:rule|checkpoint) (\w+):", re.M)
 
 
 def rule_blocks() -> dict[str, str]:
     """Rule name -> its text, over every rule file."""
     out = {}
     for f in sorted((ROOT / "rules").glob("*.smk")):
-        parts = re.split(r"(?m)^(?=rule )", f.read_text())
+        parts = re.split(r"(?m)^(?=rule |checkpoint )", f.read_text())
         out.update({m.group(1): p for p in parts if (m := RULE.match(p))})
     return out
 

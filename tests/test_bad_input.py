@@ -15,6 +15,7 @@ import pyarrow.parquet as pq
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.stage import Files
 from pipeline import config, tables
 from pipeline.stages import ingest, ingest_summary
@@ -34,7 +35,7 @@ def run(tmp: Path, houses: dict[str, object], future: Path = FIX / "future", **s
         (folder / f"{stem}.json").write_text(house if isinstance(house, str) else json.dumps(house))
     cfg = config.validate({"source": "front3d", "shards": 1,
                            "front3d": {"houses": str(folder), "future": str(future), "cache_dir": None, **section}})
-    outs = {n: tmp / "out" / f"{n}.parquet" for n in ingest.OUTPUTS}
+    outs = {n: tmp / "out" / f"{n}.parquet" for n in INGEST_OUTPUTS}
     ingest.run(cfg, Files(), Files(outs), shard=0)
     return {n: pd.read_parquet(p) for n, p in outs.items()}
 
@@ -179,7 +180,7 @@ def test_centimetre_meshes_are_reported_as_rescaled(tmp_path):
 def test_no_room_at_all_is_a_clear_error_at_ingest(tmp_path):
     t = tmp_path / "i"
     cfg = config.validate({"source": "front3d", "shards": 1, "front3d": {"houses": str(tmp_path), "future": str(FIX / "future")}})
-    outs = {n: t / f"{n}.parquet" for n in ingest.OUTPUTS}
+    outs = {n: t / f"{n}.parquet" for n in INGEST_OUTPUTS}
     ingest.run(cfg, Files(), Files(outs), shard=0)  # an empty shard is fine ...
     with pytest.raises(InputError, match="no room was ingested"):  # ... an empty corpus is not
         ingest_summary.run({}, Files(rooms=[outs["rooms"]], objects=[outs["objects"]], models=[outs["models"]],
@@ -313,7 +314,7 @@ def test_real_sample_houses_ingest_with_every_drop_named(tmp_path):
     sample = shared_data("3d-front-sample")
     cfg = config.validate({"source": "front3d", "shards": 1, "front3d": {
         "houses": str(sample / "houses"), "future": str(sample / "3d-future"), "cache_dir": str(tmp_path / "c")}})
-    outs = {n: tmp_path / f"{n}.parquet" for n in ingest.OUTPUTS}
+    outs = {n: tmp_path / f"{n}.parquet" for n in INGEST_OUTPUTS}
     ingest.run(cfg, Files(), Files(outs), shard=0)
     rooms, objs = pd.read_parquet(outs["rooms"]), pd.read_parquet(outs["objects"])
     drops = pd.read_parquet(outs["drops"])

@@ -35,8 +35,8 @@ def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path 
     return proc
 
 
-GRAPH_MODEL_RULES = ("train_graph_model", "sample_graphs", "graph_model_metrics", "train_placement", "instantiate",
-                     "evaluate", "runtime")
+# what follows new final graphs: the room_types checkpoint, then (decided once it has run) everything learned from them
+AFTER_GRAPHS = ("room_types",)
 LEARNED = ("bedroom", "office")  # tiny.yaml's graph_model.room_types: the room types trained, generated and evaluated
 TABLE3 = "results/generated/bedroom/table3.csv"  # tiny.yaml leaves Table 3 out of the default target
 
@@ -125,7 +125,7 @@ def _dry_run_with(run_dir, tmp_path, yaml_text: str, *targets: str) -> set[str]:
 
 def test_a_refinement_threshold_reruns_refinement_and_after_only(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n  thresholds: {proximal: 0.2}\n")
-    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report", *GRAPH_MODEL_RULES}
+    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report", *AFTER_GRAPHS}
 
 
 def test_a_chain_setting_reruns_the_statistics_map_step(run_dir, tmp_path):
@@ -154,19 +154,19 @@ def test_a_filter_threshold_reruns_only_downstream(run_dir, tmp_path):
 
 def test_forcerun_refine_reruns_only_refinement_and_after(run_dir):
     jobs = planned_jobs(snakemake(run_dir, "--dry-run", "--forcerun", "refine_graphs"))
-    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report", *GRAPH_MODEL_RULES}
+    assert jobs == {"refine_graphs", "gather_graphs", "score_superstructures", "graph_report", *AFTER_GRAPHS}
 
 
 def test_a_sampling_setting_resamples_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n"
                                             "graph_model:\n  sample: {graphs: 20, batch_size: 20, temperature: 0.8}\n")
-    assert jobs == {"sample_graphs", "graph_model_metrics", "instantiate", "evaluate", "runtime"}  # placed, scored again
+    assert jobs == {"sample_graphs", "graph_model_metrics", "generate", "evaluate", "runtime"}  # placed, scored again
 
 
 def test_a_search_setting_replaces_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\ninstantiate:\n  samples: 12\n",
                          "all", TABLE3)
-    assert jobs == {"instantiate", "table3", "evaluate", "runtime"}  # the placement networks are kept
+    assert jobs == {"generate", "instantiate", "table3", "evaluate", "runtime"}  # the placement networks are kept
 
 
 def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
@@ -260,7 +260,7 @@ def test_the_run_time_table_holds_every_benchmarked_job(run_dir):
     built = (run_dir / "results" / "runtime.csv").stat().st_mtime  # Table 3's jobs ran later, in a second run
     jobs = [p for p in (run_dir / "benchmarks").glob("*/*.tsv") if p.stat().st_mtime <= built]
     rules = {p.parent.name for p in jobs}
-    assert rules == set(table.index[2:]) and {"ingest", "train_placement", "instantiate", "evaluate"} <= rules
+    assert rules == set(table.index[2:]) and {"ingest", "train_placement", "generate", "evaluate"} <= rules
     assert table.loc[TOTAL, "jobs"] == len(jobs) and table.loc[TOTAL, "jobs"] == table.jobs.iloc[2:].sum()
     wall, total = table.loc[WALL, "job_seconds"], table.loc[TOTAL, "job_seconds"]
     assert 0 < wall and total / 2 - 1 <= wall  # two cores: the span is at least half the job time
@@ -357,3 +357,33 @@ def test_any_corpus_of_canonical_tables_runs_through_the_same_rules(run_dir, tmp
     for name in ("extraction", "superstructures"):
         assert (json.loads((res / f"metrics/copy/{name}.json").read_text())
                 == json.loads((res / f"metrics/ingested/{name}.json").read_text()))
+
+
+def test_a_method_registered_from_outside_runs_through_generation_evaluation_and_report(run_dir, tmp_path):
+    """tests/toy_method.py (uniform random rooms, no training) registers itself through the interface alone: a config
+    naming it (generation.plugins, generation.methods) carries it through the generate rule, the evaluation and the
+    report; no file of the pipeline changes."""
+    work = tmp_path / "run"
+    shutil.copytree(run_dir, work, symlinks=True)
+    extra = tmp_path / "toy.yaml"
+    extra.write_text("generation: {methods: [planit, toy, retrieval], plugins: [toy_method]}\n")
+    env = {"PYTHONPATH": str(ROOT / "tests")}
+    jobs = planned_jobs(snakemake(work, "--dry-run", extra_config=extra, env_extra=env))
+    assert jobs == {"generate", "evaluate", "runtime"}, jobs  # nothing learned again: toy trains nothing
+    snakemake(work, extra_config=extra, env_extra=env)
+    res = work / "results"
+    for room_type in LEARNED:
+        scenes = pd.read_parquet(res / "generated" / room_type / "toy" / "scenes.parquet")
+        objects = pd.read_parquet(res / "generated" / room_type / "toy" / "objects.parquet")
+        assert len(scenes) and (scenes.status == "placed").all() and set(objects.room_id) <= set(scenes.scene_id)
+        m = json.loads((res / "eval" / room_type / "metrics.json").read_text())
+        assert set(m["sets"]) == {"planit", "toy", "retrieval", "real_heldout"}
+        assert set(m["sets"]["toy"]) == set(m["sets"]["planit"])  # every metric, by the same code
+        assert "toy" in set(pd.read_csv(res / "eval" / room_type / "metrics.csv")["set"])
+    report = work / "results" / "report.html"
+    snakemake(work, "--report", str(report), extra_config=extra, env_extra=env)
+    assert '"results/eval/bedroom/metrics.csv": {' in report.read_text()
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("generation: {methods: [planit, nosuch]}\n")
+    out = snakemake(work, "--dry-run", extra_config=bad, check=False)
+    assert out.returncode != 0 and "generation method 'nosuch' is not registered" in out.stdout + out.stderr

@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.stage import Files
 from pipeline.corpus import catalog, procedural
 
@@ -98,7 +99,7 @@ def test_hard_placements_are_recovered_per_case(tmp_path):
     cfg = config_mod.validate({"shards": 1, "procedural": {
         "rooms": {"bedroom": 25, "living": 25, "office": 25, "bathroom": 10, "kitchen": 15}, "defect_rate": 0.0,
         "placement": {"flush": 0.35, "overlap": 0.35, "turned": 1.0}}})
-    t = {name: tmp_path / f"{name}.parquet" for name in ingest.OUTPUTS}
+    t = {name: tmp_path / f"{name}.parquet" for name in INGEST_OUTPUTS}
     ingest.run(cfg, Files(), Files(t), shard=0)
     symmetry.run(cfg, Files(models=[t["models"]]), Files(table=tmp_path / "symmetry.parquet", agreement=tmp_path / "agreement.json"))
     extract_graphs.run(cfg, Files(rooms=t["rooms"], architecture=t["architecture"], objects=t["objects"], models=t["models"], symmetry=tmp_path / "symmetry.parquet"),

@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 import shapely
 
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.stage import Files
 from pipeline import config
 from pipeline.corpus import front3d
@@ -22,7 +23,7 @@ FIX = Path(__file__).parent / "fixtures"
 
 
 def ingest_outputs(folder: Path, shard: int = 0) -> dict[str, Path]:
-    return {name: folder / f"{name}-{shard}.parquet" for name in ingest.OUTPUTS}
+    return {name: folder / f"{name}-{shard}.parquet" for name in INGEST_OUTPUTS}
 
 
 def run_ingest(source: str, section: dict, tmp_path) -> dict[str, pd.DataFrame]:

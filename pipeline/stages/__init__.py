@@ -54,6 +54,8 @@ _ALL = [
     Stage("graph_report", "Write the graph report: Table 1, pruning by rule, frequent relations (CSV) and a PNG.",
           inputs=(one("nodes"), one("edges"), one("superstructures")),
           outputs=(one("table1"), one("pruning"), one("relations"), one("plot"))),
+    Stage("room_types", "The room types to learn: the candidates with enough graphs, the others skipped with a reason.",
+          inputs=(one("nodes", "final nodes"),), outputs=(one("table", "room_types.csv"),)),
     Stage("split_rooms", "Split one room type's rooms into fit, validation and held-out rooms (seeded).",
           inputs=(one("nodes", "final nodes"),), outputs=(one("split"),), params=(ROOM_TYPE,)),
     Stage("train_graph_model", "Train the graph generative model of one room type (resumes from the checkpoint "

@@ -77,6 +77,20 @@ def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) ->
     return total / max(len(seqs), 1), dropped
 
 
+def _resume(model, opt, checkpoint: Path, config_hash: str, device: str) -> dict:
+    """The training state to go on from: the progress file's when it is of these settings (weights and optimiser
+    loaded into ``model`` and ``opt``), else a fresh one."""
+    saved = ckpt.resume(checkpoint, PROGRESS, config_hash, device)
+    if saved is None:
+        if checkpoint.exists():
+            log.info("checkpoint %s is for other settings: starting afresh", checkpoint)
+        return {"epoch": 0, "history": [], "best": np.inf, "best_epoch": 0, "best_state": None, "stale": 0}
+    model.load_state_dict(saved.state["model"])
+    opt.load_state_dict(saved.state["optimizer"])
+    log.info("resumed from %s after epoch %d", checkpoint, saved.record["epoch"])
+    return {**saved.record, "best_state": saved.state["best_state"]}
+
+
 def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, preset: dict, max_edges: int, seed: int,
           checkpoint: Path, config_hash: str, device: str = "cpu", progress=None) -> Run:
     """Fit ``train_graphs`` until the ``validation`` NLL has not improved by ``preset['min_improvement']``
@@ -85,17 +99,8 @@ def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, pres
     torch.manual_seed(seed)
     model = build_model(vocab, preset).to(device)
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
-    state = {"epoch": 0, "history": [], "best": np.inf, "best_epoch": 0, "best_state": None, "stale": 0}
-    resumed = 0
-    saved = ckpt.resume(checkpoint, PROGRESS, config_hash, device)
-    if saved is not None:
-        model.load_state_dict(saved.state["model"])
-        opt.load_state_dict(saved.state["optimizer"])
-        state = {**saved.record, "best_state": saved.state["best_state"]}
-        resumed = state["epoch"]
-        log.info("resumed from %s after epoch %d", checkpoint, resumed)
-    elif checkpoint.exists():
-        log.info("checkpoint %s is for other settings: starting afresh", checkpoint)
+    state = _resume(model, opt, checkpoint, config_hash, device)
+    resumed = state["epoch"]
     while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
         epoch = state["epoch"] + 1
         start = time.perf_counter()
