@@ -24,7 +24,7 @@ from pipeline import tables
 from pipeline.evaluation import distributions
 from pipeline.evaluation import scores as evaluate_scores
 from pipeline.evaluation.sets import load_real
-from pipeline.graphs.load import read_split
+from pipeline.graphs.files import read_split
 from pipeline.stages import sample_graphs
 
 from common import ROOT, arguments, report

@@ -23,7 +23,7 @@ from pipeline.graphs import data as graph_data
 from pipeline.methods.planit.graph_model import sampler
 from pipeline.methods.planit.graph_model import train
 from pipeline.methods.planit.graph_model.teacher import make_batch, nll
-from pipeline.graphs.load import room_graphs
+from pipeline.graphs.files import room_graphs
 
 from common import ROOT, arguments, report
 

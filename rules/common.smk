@@ -18,6 +18,7 @@ except planit_config.ConfigError as exc:
     raise WorkflowError(str(exc)) from None
 
 from pipeline import methods as planit_methods
+from pipeline.graphs.files import spec_room_type
 from pipeline.methods.builtin import search_keys
 from pipeline.stage import option
 from pipeline.stages import STAGES
@@ -39,6 +40,9 @@ wildcard_constraints:
     corpus="[a-z][a-z0-9_]*",
     shard="[0-9]+",
     room_type="[a-z][a-z0-9_]*",
+    spec="[A-Za-z0-9_]+",
+    room="[A-Za-z0-9_.]+",
+    keep="[0-9]+",
     net="cfcn|fcn",
     method="|".join(config["generation"]["methods"]),
     variant="|".join(v for v, s in config["instantiate"]["variants"].items() if s["graphs"] == "heldout"),
@@ -71,6 +75,9 @@ GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
 PLACEMENT = "results/placement/{room_type}/{net}/{name}"
 GENERATED = "results/generated/{room_type}/{method}/{name}"
 ABLATION = "results/generated/{room_type}/{variant}/{name}"  # Table 3's variants (held-out graphs)
+SPEC = "results/specs/{spec}/{name}"  # a partial graph's completions (graphs/) and their rooms
+SPEC_FILE = f"{workflow.basedir}/config/specs/{{spec}}.yaml"
+COMPLETE = "results/complete/{room_type}/{room}-keep{keep}/{name}"  # a real room completed around its first objects
 TABLE3 = "results/generated/{room_type}/table3.csv"
 EVAL = "results/eval/{room_type}/{name}"
 SPLIT = "results/splits/{room_type}.parquet"
@@ -187,6 +194,18 @@ def get_method_inputs(wildcards):
         out |= {f"reference_{t}": GENERATED.format(room_type=wildcards.room_type, method=m.reference, name=f"{t}.parquet")
                 for t in ("rooms", "architecture", "objects", "scenes")}
     return out
+
+
+def spec_graph_model(wildcards):
+    """The graph model of a spec's room type."""
+    return GRAPH_MODEL.format(room_type=spec_room_type(SPEC_FILE.format(spec=wildcards.spec)), name="model.pt")
+
+
+def spec_placement(wildcards):
+    """The placement networks (CFCN) and the split of a spec's room type."""
+    room_type = spec_room_type(SPEC_FILE.format(spec=wildcards.spec))
+    return {"model": PLACEMENT.format(room_type=room_type, net="cfcn", name="model.pt"),
+            "split": SPLIT.format(room_type=room_type)}
 
 
 def get_ablation_model(wildcards):

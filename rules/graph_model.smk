@@ -110,3 +110,27 @@ rule graph_model_metrics:
         ENV
     shell:
         STAGE
+
+
+rule complete_graphs:
+    input:
+        model=spec_graph_model,
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+        spec_file=SPEC_FILE,
+    output:
+        nodes=SPEC.replace("{name}", "graphs/nodes.parquet"),
+        edges=SPEC.replace("{name}", "graphs/edges.parquet"),
+        summary=SPEC.replace("{name}", "graphs/summary.json"),
+    params:
+        config=keys("seed", "graph_model.sample"),
+        io=stage_io("complete_graphs"),
+    threads: 1
+    log:
+        "logs/complete_graphs/{spec}.log",
+    benchmark:
+        "benchmarks/complete_graphs/{spec}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE

@@ -92,6 +92,65 @@ rule instantiate:
         STAGE
 
 
+rule place_graphs:
+    input:
+        unpack(spec_placement),
+        nodes=SPEC.replace("{name}", "graphs/nodes.parquet"),
+        edges=SPEC.replace("{name}", "graphs/edges.parquet"),
+        rooms=shards_of(FILTER_ROOMS),
+        architecture=shards_of(INGEST, table="architecture"),
+        objects=shards_of(INGEST, table="objects"),
+        models=shards_of(INGEST, table="models"),
+        symmetry=SYMMETRY.format(corpus="ingested"),
+        category_sizes=STATS.format(corpus="ingested", name="category_sizes"),
+    output:
+        **{t: SPEC.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
+        summary=SPEC.replace("{name}", "summary.json"),
+        files=directory(SPEC.replace("{name}", "scenes")),
+    params:
+        config=keys(*search_keys(config, "planit")),
+        io=stage_io("place_graphs"),
+    threads: 1
+    log:
+        "logs/place_graphs/{spec}.log",
+    benchmark:
+        "benchmarks/place_graphs/{spec}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
+
+
+rule complete_room:
+    input:
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+        model=PLACEMENT.replace("{net}", "cfcn").replace("{name}", "model.pt"),
+        rooms=shards_of(FILTER_ROOMS),
+        architecture=shards_of(INGEST, table="architecture"),
+        objects=shards_of(INGEST, table="objects"),
+        models=shards_of(INGEST, table="models"),
+        split=SPLIT,
+        symmetry=SYMMETRY.format(corpus="ingested"),
+        category_sizes=STATS.format(corpus="ingested", name="category_sizes"),
+    output:
+        **{t: COMPLETE.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
+        summary=COMPLETE.replace("{name}", "summary.json"),
+        files=directory(COMPLETE.replace("{name}", "scenes")),
+    params:
+        config=keys(*search_keys(config, "heldout")),
+        io=stage_io("complete_room"),
+    threads: 1
+    log:
+        "logs/complete_room/{room_type}-{room}-{keep}.log",
+    benchmark:
+        "benchmarks/complete_room/{room_type}-{room}-{keep}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
+
+
 rule table3:
     input:
         summaries=expand(ABLATION, variant=TABLE3_VARIANTS, name="summary.json", allow_missing=True),

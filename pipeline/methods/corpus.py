@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import tables
-from ..graphs.load import read_split
+from ..graphs.files import read_split
 from ..room import load_rooms
 from .interface import Corpus, Generated
 

@@ -96,14 +96,16 @@ class LayoutGenerator(Protocol):
 
 
 class GraphGenerator(Protocol):
-    def fit(self, config: dict, graphs: list, split: dict[str, str], room_type: str, progress_file: Path,
+    def fit(self, config: dict, vocab, graphs: list, split: dict[str, str], room_type: str, progress_file: Path,
             threads: int = 1):
-        """Learn from the fit (and validation) graphs; return what the rule writes (checkpoint, history, summary)."""
+        """Learn from the fit graphs (validation graphs choose when to stop); return a ``learning.fitted.Fitted``
+        (typed checkpoint, history, summary, loss curves). ``progress_file`` resumes an interrupted run."""
 
-    def sample(self, config: dict, model: Path, graphs: list, room_type: str, spec: Path | None = None,
-               count: int | None = None) -> tuple[list[dict], list[dict], dict]:
-        """Graphs in held-out rooms' architectures (or completing ``spec``) as generated_nodes / generated_edges
-        rows, and a summary."""
+    def sample(self, config: dict, model: Path, graphs: list, nodes: Path, edges: Path, room_type: str,
+               spec: Path | None = None, count: int | None = None, threads: int = 1,
+               prefix: str | None = None) -> tuple[list[dict], list[dict], dict]:
+        """Graphs in held-out rooms' architectures (or completing the partial graph ``spec``) as generated_nodes /
+        generated_edges rows, and a summary of the sampling."""
 
 
 @dataclass(frozen=True)

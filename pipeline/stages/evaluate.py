@@ -9,7 +9,7 @@ from ..evaluation.evaluate import evaluate_room_type
 from ..evaluation.gallery import gallery
 from ..evaluation.scores import metrics_table
 from ..evaluation.sets import generated_sets, load_real
-from ..graphs.load import read_split
+from ..graphs.files import read_split
 from ..stage import Files
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 from .. import tables
 from ..evaluation.graph_model import graph_model_metrics
 from ..graphs import data as graph_data
-from ..graphs.load import room_graphs
+from ..graphs.files import room_graphs
 from ..stage import Files
 
 log = logging.getLogger("planit.graph_model_metrics")

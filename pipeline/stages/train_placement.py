@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from .. import tables
 from ..errors import InputError
-from ..graphs.load import read_split
+from ..graphs.files import read_split
 from ..room import load_rooms
 from ..stage import Files
 
 
 def run(config: dict, inp: Files, out: Files, room_type: str, net: str, threads: int = 1) -> dict:
-    from ..learning import checkpoint
+    from ..learning.fitted import write_fitted
     from ..methods.planit.nets.fit import fit_room_type, training_rooms
 
     flt = [("room_type", "=", room_type)]
@@ -22,8 +22,4 @@ def run(config: dict, inp: Files, out: Files, room_type: str, net: str, threads:
     cats, train_rooms, held_rooms, held_ids = training_rooms(rooms, node_df, edge_df, read_split(inp.split))
     fitted = fit_room_type(config, room_type, net, cats, train_rooms, held_rooms, held_ids,
                            out.model.with_name("checkpoint.pt"), threads)
-    checkpoint.save(out.model, fitted.checkpoint)
-    tables.write_csv(out.history, fitted.history)
-    tables.write_figure(out.curve, fitted.curve)
-    tables.write_json(out.summary, fitted.summary)
-    return fitted.summary
+    return write_fitted(out, fitted)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import logging
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterator
 
@@ -134,3 +134,30 @@ class PlanitLayout:
             seed = zlib.crc32(f"{self.config['seed']}/{self.name}/{plan.scene_id}".encode())
             outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed)
             yield scene_of(plan, ctx, outcome, walls)
+
+
+class CompleteRoom:
+    """Completion of a real room: its first ``keep`` objects (of the constraint order) stay where they are, the search
+    places the rest of its final graph (the held-out graphs' variant)."""
+
+    def __init__(self, config: dict, room: str, keep: int):
+        self.config, self.room, self.keep = config, room, keep
+        self.variant = config["instantiate"]["variants"]["heldout"]
+        self.info = {"room": room, "keep": keep, **self.variant}
+
+    def generate(self, task: Task) -> Iterator[Scene]:
+        torch.set_num_threads(task.threads)
+        flt = [("room_id", "=", self.room)]
+        nodes = tables.read(task.graphs[0], "final_nodes", filters=flt).to_pandas()
+        if nodes.empty or self.room not in task.corpus.inputs:
+            raise InputError(f"{task.graphs[0]}: no room '{self.room}' among the kept {task.corpus.room_type} rooms")
+        edges = tables.read(task.graphs[1], "final_edges", filters=flt).to_pandas()
+        plan = replace(plans_from_tables(nodes, edges)[0], scene_id=f"{self.room}_keep{self.keep}")
+        if not 0 <= self.keep <= len(plan.ids):
+            raise InputError(f"keep: {self.keep}, but room {self.room} has {len(plan.ids)} objects")
+        saved = checkpoint.load(task.model, KIND)
+        ctx = load_context(self.config, task.corpus)
+        proposer = make_proposer("cfcn", saved, self.config["instantiate"])
+        seed = zlib.crc32(f"{self.config['seed']}/complete/{plan.scene_id}".encode())
+        outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)
+        yield scene_of(plan, ctx, outcome, walls)

@@ -3,7 +3,6 @@ are scored once, after training)."""
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -15,18 +14,11 @@ from ....graphs import checks as graph_checks
 from ....graphs.data import Graph, Vocab
 from ....learning.checkpoint import Checkpoint
 from ....learning.device import pick_device
+from ....learning.fitted import Fitted
 from ....log import progress
 from . import train
 
 log = logging.getLogger("planit.train_graph_model")
-
-
-@dataclass
-class Fitted:
-    checkpoint: Checkpoint
-    history: pd.DataFrame
-    summary: dict
-    curve: object  # matplotlib figure
 
 
 def fit_room_type(config: dict, vocab: Vocab, graphs: list[Graph], split: dict[str, str], room_type: str,

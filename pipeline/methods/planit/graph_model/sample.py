@@ -37,10 +37,12 @@ def load_model(path: Path):
 
 
 def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges: Path, room_type: str,
-                     spec: Path | None = None, count: int | None = None, threads: int = 1) -> tuple[list, list, dict]:
+                     spec: Path | None = None, count: int | None = None, threads: int = 1,
+                     prefix: str | None = None) -> tuple[list, list, dict]:
     """``count`` (default ``graph_model.sample.graphs``) valid graphs as generated_nodes / generated_edges rows, and
     a summary of the sampling; with ``spec``, graphs that complete that partial graph. ``graphs``: the room type's
-    final graphs (``nodes``, ``edges``: their tables, whose architecture rows the sampled graphs copy)."""
+    final graphs (``nodes``, ``edges``: their tables, whose architecture rows the sampled graphs copy); scene ids
+    are ``<prefix>_<k>`` (default ``gen_<room type>``)."""
     sc = config["graph_model"]["sample"]
     torch.set_num_threads(threads)
     saved, vocab, net = load_model(model)
@@ -57,12 +59,12 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     if not held:
         raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
     n = count or sc["graphs"]
-    base_seed = zlib.crc32(f"{config['seed']}/{room_type}/{spec or ''}".encode())
+    base_seed = zlib.crc32(f"{config['seed']}/{room_type}/{Path(spec).name if spec else ''}".encode())
     kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, saved["max_edges"], room_type)
-    rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type)
+    rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"gen_{room_type}")
     summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": n - len(kept),
                "valid_before_rejection": round(first_try / max(n, 1), 4), "rejections": dict(reasons),
-               "temperature": sc["temperature"], "spec": str(spec) if spec else None}
+               "temperature": sc["temperature"], "spec": Path(spec).name if spec else None}
     log.info("%s", summary)
     return rows_n, rows_e, summary
 
@@ -95,7 +97,7 @@ def _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, max_edges, roo
     return kept, first_try, reasons
 
 
-def graph_rows(kept: dict, vocab, nodes: Path, edges: Path, room_type: str) -> tuple[list[dict], list[dict]]:
+def graph_rows(kept: dict, vocab, nodes: Path, edges: Path, room_type: str, prefix: str) -> tuple[list[dict], list[dict]]:
     """The kept graphs as generated_nodes / generated_edges rows, architecture copied from their rooms."""
     flt = [("room_type", "=", room_type)]
     arch_rows = _architecture_rows(tables.read(nodes, "final_nodes", filters=flt).to_pandas(),
@@ -104,7 +106,7 @@ def graph_rows(kept: dict, vocab, nodes: Path, edges: Path, room_type: str) -> t
     for i in sorted(kept):
         g, seed = kept[i]
         an, ae = arch_rows[g.arch.room_id]
-        nn_, ee = grown_rows(g, vocab, an, ae, f"gen_{room_type}_{i:05d}", room_type, seed)
+        nn_, ee = grown_rows(g, vocab, an, ae, f"{prefix}_{i:05d}", room_type, seed)
         rows_n += nn_
         rows_e += ee
     return rows_n, rows_e

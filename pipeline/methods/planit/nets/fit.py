@@ -4,7 +4,6 @@ ablation."""
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -14,20 +13,13 @@ from ....config import config_hash
 from ....errors import InputError
 from ....learning.checkpoint import Checkpoint
 from ....learning.device import pick_device
+from ....learning.fitted import Fitted
 from ....log import progress
 from . import train as nets_train
 from .data import TrainingRoom, training_room
 
 log = logging.getLogger("planit.train_placement")
 NETS = ("cfcn", "fcn")
-
-
-@dataclass
-class Fitted:
-    checkpoint: Checkpoint
-    history: pd.DataFrame
-    summary: dict
-    curve: object  # matplotlib figure
 
 
 def training_rooms(inputs: dict, node_df: pd.DataFrame, edge_df: pd.DataFrame, split: dict[str, str]):

@@ -1,4 +1,5 @@
-"""Reading final relation graphs of one room type from the gathered tables (for every learner and metric)."""
+"""Relation-graph files of one room type: reading final graphs and splits (every learner and metric), writing sampled
+graphs (every graph generator), the room type a partial-graph spec names."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -28,3 +29,24 @@ def read_split(path: Path) -> dict[str, str]:
 def split_ids(split: dict[str, str], *names: str) -> list[str]:
     """The sorted room ids in any of the named parts of a split."""
     return sorted(r for r, s in split.items() if s in names)
+
+
+def write_graphs(out, nodes: list[dict], edges: list[dict], summary: dict) -> None:
+    """Sampled graphs as generated_nodes / generated_edges tables and their sampling summary (``out``: nodes, edges,
+    summary)."""
+    tables.write(out.nodes, "generated_nodes", tables.from_rows("generated_nodes", nodes))
+    tables.write(out.edges, "generated_edges", tables.from_rows("generated_edges", edges))
+    tables.write_json(out.summary, summary)
+
+
+def spec_room_type(spec: Path) -> str:
+    """The room type a partial-graph spec names (the spec is validated in full when sampling)."""
+    import yaml
+
+    try:
+        value = (yaml.safe_load(Path(spec).read_text()) or {}).get("room_type")
+    except (OSError, yaml.YAMLError, AttributeError) as exc:
+        raise InputError(f"{spec}: cannot read the spec ({exc})") from exc
+    if not isinstance(value, str):
+        raise InputError(f"{spec}: room_type: missing (a room type such as bedroom)")
+    return value
