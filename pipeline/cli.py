@@ -116,14 +116,13 @@ for _declared in STAGES.values():
 
 
 @app.command()
-def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, 'graphs' / a folder of gathered graph tables, "
-                                               "or 'graph_model' / a metrics JSON"),
+def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, a folder of gathered graph tables "
+                                               "(results/graphs/<corpus>), or the graph models' folder "
+                                               "(results/graph_model) or one of their metrics JSON"),
           room: Optional[str] = typer.Option(None, "--room", help="print this room's graph")) -> None:
     """Print a table's schema, row count and per-column summary; for graphs, the per-room-type report. Reads only."""
-    if str(path) == "graphs" and not path.exists():
-        path = Path("results/graphs/ingested")
-    if str(path) == "graph_model" and not path.exists():
-        path = Path("results/graph_model")
+    if not path.exists():
+        _fail(f"{path}: no such table, folder or metrics file")
     if path.is_dir() and (path / "metrics.json").exists() or path.suffix == ".json" or path.name == "graph_model":
         from .stats import print_metrics
 

@@ -115,7 +115,8 @@ def test_real_furniture_meshes_overlap_far_less_than_their_boxes(tmp_path):
     cfg = config.validate({"source": "front3d", "shards": 1})
     ing = tmp_path / "ingest"
     symmetry.run(cfg, Files(models=[ing / "models-0.parquet"]), Files(table=tmp_path / "sym.parquet", agreement=tmp_path / "sym.json"))
-    extract_graphs.run(cfg, Files(rooms=ing / "rooms-0.parquet", architecture=ing / "architecture-0.parquet", objects=ing / "objects-0.parquet", models=ing / "models-0.parquet", symmetry=tmp_path / "sym.parquet"),
+    extract_graphs.run(cfg, Files(rooms=ing / "rooms-0.parquet", architecture=ing / "architecture-0.parquet", objects=ing / "objects-0.parquet",
+                                  models=ing / "models-0.parquet", symmetry=tmp_path / "sym.parquet"),
                        Files(nodes=tmp_path / "n.parquet", edges=tmp_path / "e.parquet", summary=tmp_path / "s.json"), shard=0)
     nodes = pd.read_parquet(tmp_path / "n.parquet")
     edges = pd.read_parquet(tmp_path / "e.parquet")

@@ -225,7 +225,8 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
     gen = res / "generated" / "bedroom" / "planit"
     placed = pd.read_parquet(gen / "scenes.parquet").placed_objects.sum()
     cfg = config_mod.validate({"seed": 7})
-    extract_graphs.run(cfg, Files(rooms=gen / "rooms.parquet", architecture=gen / "architecture.parquet", objects=gen / "objects.parquet", models=gen / "models.parquet", symmetry=res / "graphs/ingested/symmetry.parquet"),
+    extract_graphs.run(cfg, Files(rooms=gen / "rooms.parquet", architecture=gen / "architecture.parquet", objects=gen / "objects.parquet",
+                                  models=gen / "models.parquet", symmetry=res / "graphs/ingested/symmetry.parquet"),
                        Files(nodes=tmp_path / "n.parquet", edges=tmp_path / "e.parquet", summary=tmp_path / "s.json"), shard=0)
     nodes = pd.read_parquet(tmp_path / "n.parquet")
     assert (nodes.kind == "object").sum() == placed

@@ -296,7 +296,8 @@ def test_real_3d_front_rooms_are_placed_again_from_their_own_graphs(tmp_path):
     cfg = config_mod.validate({"source": "front3d", "shards": 1, "instantiate": {"time_budget": 600}})
     outs = ingest_outputs(tmp_path / "ingest")
     symmetry.run(cfg, Files(models=[outs["models"]]), Files(table=tmp_path / "sym.parquet", agreement=tmp_path / "sym.json"))
-    extract_graphs.run(cfg, Files(rooms=outs["rooms"], architecture=outs["architecture"], objects=outs["objects"], models=outs["models"], symmetry=tmp_path / "sym.parquet"),
+    extract_graphs.run(cfg, Files(rooms=outs["rooms"], architecture=outs["architecture"], objects=outs["objects"],
+                                  models=outs["models"], symmetry=tmp_path / "sym.parquet"),
                        Files(nodes=tmp_path / "n.parquet", edges=tmp_path / "e.parquet", summary=tmp_path / "s.json"), shard=0)
     plans = [p for p in own_plans(pd.read_parquet(tmp_path / "n.parquet"), pd.read_parquet(tmp_path / "e.parquet"))
              if 3 <= len(p.ids) <= 8]

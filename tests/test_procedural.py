@@ -102,7 +102,8 @@ def test_hard_placements_are_recovered_per_case(tmp_path):
     t = {name: tmp_path / f"{name}.parquet" for name in INGEST_OUTPUTS}
     ingest.run(cfg, Files(), Files(t), shard=0)
     symmetry.run(cfg, Files(models=[t["models"]]), Files(table=tmp_path / "symmetry.parquet", agreement=tmp_path / "agreement.json"))
-    extract_graphs.run(cfg, Files(rooms=t["rooms"], architecture=t["architecture"], objects=t["objects"], models=t["models"], symmetry=tmp_path / "symmetry.parquet"),
+    extract_graphs.run(cfg, Files(rooms=t["rooms"], architecture=t["architecture"], objects=t["objects"],
+                                  models=t["models"], symmetry=tmp_path / "symmetry.parquet"),
                        Files(nodes=tmp_path / "nodes.parquet", edges=tmp_path / "edges.parquet", summary=tmp_path / "summary.json"), shard=0)
     scores = score_extraction.run(cfg, Files(nodes=[tmp_path / "nodes.parquet"], edges=[tmp_path / "edges.parquet"],
                                              ground_truth=[t["ground_truth"]]), Files(metrics=tmp_path / "scores.json"))

@@ -190,7 +190,8 @@ def test_ithor_real_rooms_support_parents_agree(tmp_path):
                                 models=outs["models"], counts=t / "counts.parquet"),
                      Files(rooms=t / "kept.parquet", report=t / "filter.parquet"))
     symmetry.run(cfg, Files(models=[outs["models"]]), Files(table=t / "sym.parquet", agreement=t / "sym.json"))
-    extract_graphs.run(cfg, Files(rooms=t / "kept.parquet", architecture=outs["architecture"], objects=outs["objects"], models=outs["models"], symmetry=t / "sym.parquet"),
+    extract_graphs.run(cfg, Files(rooms=t / "kept.parquet", architecture=outs["architecture"], objects=outs["objects"],
+                                  models=outs["models"], symmetry=t / "sym.parquet"),
                        Files(nodes=t / "nodes.parquet", edges=t / "edges.parquet", summary=t / "summary.json"), shard=0)
     metrics = score_extraction.run(cfg, Files(nodes=[t / "nodes.parquet"], edges=[t / "edges.parquet"],
                                               ground_truth=[outs["ground_truth"]]), Files(metrics=t / "m.json"))

@@ -3,7 +3,7 @@ none) and a layout generator, registered in one place (``pipeline.methods``).
 
 - A **graph generator** learns the relation graphs of a room type from the fit split's final graphs and samples
   graphs for rooms' architectures, or completes a partial graph (:class:`GraphGenerator`). PlanIT's graph model is
-  one: its rules ``train_graph_model`` and ``sample_graphs`` write ``results/graph_model/<type>/sampled/``.
+  one: its rules ``train_graph_model`` and ``sample_graphs`` write its model and sampled graphs.
 - A **layout generator** places objects into rooms' architectures, from the graph generator's graphs or without
   any (:class:`LayoutGenerator`): given a :class:`Task`, it yields one :class:`Scene` per room it generates. It
   trains in rules of its own if it learns anything (PlanIT's placement networks: ``train_placement``).
