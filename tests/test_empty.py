@@ -47,3 +47,19 @@ def test_every_per_shard_stage_runs_on_a_shard_with_no_rooms(tmp_path):
                       Files(out, summary=tmp_path / "final.json"), shard=0)
     for name, schema in (("nodes", "final_nodes"), ("edges", "final_edges"), ("superstructures", "superstructures")):
         _assert_empty(out[name], schema)
+
+
+def test_a_room_type_with_too_few_rooms_is_skipped_with_its_reason(tmp_path):
+    import pandas as pd
+
+    from pipeline.stages import room_types
+
+    rows = [{"room_id": f"{t}_{k}", "node_id": "n", "room_type": t, "kind": "object"}
+            for t, n in (("bedroom", 3), ("office", 2)) for k in range(n)]
+    tables.write(tmp_path / "nodes.parquet", "final_nodes", tables.from_rows("final_nodes", rows))
+    cfg = config.validate({"graph_model": {"room_types": ["bedroom", "office", "kitchen"]}})
+    room_types.run(cfg, Files(nodes=tmp_path / "nodes.parquet"), Files(table=tmp_path / "types.csv"))
+    got = pd.read_csv(tmp_path / "types.csv", keep_default_na=False).set_index("room_type")
+    assert got.status.to_dict() == {"bedroom": "learned", "office": "skipped", "kitchen": "skipped"}
+    assert got.loc["office", "reason"] == "2 room(s); training needs 3"
+    assert got.loc["kitchen", "reason"] == "no room of this type passed the filter"
