@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 REQUIRED = object()
 
@@ -24,9 +24,9 @@ class Port:
     help: str = ""
 
 
-@dataclass(frozen=True)
-class Param:
-    """A scalar option: a wildcard of the rule (shard, room type, method, ...) or a setting of a hand-run."""
+class Param(NamedTuple):
+    """A scalar option: a wildcard of the rule (shard, room type, method, ...) or a setting of a hand-run
+    (``default``: ``REQUIRED`` for a required option)."""
     name: str
     type: type = str
     default: Any = REQUIRED

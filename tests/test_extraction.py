@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
-from pipeline.corpus import catalog
+from pipeline.corpus import furniture
 from pipeline.geometry import relations
 from conftest import Room, default_config, edge, l_sofa_mesh, table_mesh
 
@@ -85,7 +85,7 @@ def test_partly_hidden_target_needs_30_percent():
 
 def test_radial_anchor_labels_everything_front():
     r = Room([[0, 0], [6, 0], [6, 6], [0, 6]])
-    v, f, (w, d, h) = catalog.build_model("round_table", 0, 0)
+    v, f, (w, d, h) = furniture.build_model("round_table", 0, 0)
     r.add("table", "round_table", (w, d, h), (3.0, 3.0), mesh=(v, f))
     r.add("c_right", "chair", (0.45, 0.5, 0.9), (3.0 + w / 2 + 0.3, 3.0), yaw_deg=90)
     r.add("c_back", "chair", (0.45, 0.5, 0.9), (3.0, 3.0 - d / 2 - 0.3))

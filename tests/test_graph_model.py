@@ -176,9 +176,9 @@ def test_invalid_specs_name_the_problem(bedrooms, tmp_path, body, message):
 def test_example_specs_are_valid():
     import yaml
 
-    from pipeline.corpus import catalog
+    from pipeline.corpus import furniture
 
-    vocab = graph_data.Vocab(tuple(sorted(catalog.CATEGORIES)))  # every category the procedural corpus has
+    vocab = graph_data.Vocab(tuple(sorted(furniture.CATEGORIES)))  # every category the procedural corpus has
     files = sorted((ROOT / "config" / "specs").glob("*.yaml"))
     assert len(files) >= 2
     for f in files:

@@ -19,7 +19,7 @@ from pipeline.placement.checks import Checker
 from pipeline.placement.layout import View, add_object, render, walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
-from pipeline.placement.retrieval import Catalog, place
+from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import instantiate
 
 SIZES = {"bed": (1.6, 2.0, 0.5), "nightstand": (0.5, 0.4, 0.55), "table_lamp": (0.2, 0.2, 0.4),
@@ -27,7 +27,7 @@ SIZES = {"bed": (1.6, 2.0, 0.5), "nightstand": (0.5, 0.4, 0.55), "table_lamp": (
 
 
 def catalog_room(categories, outline=((0, 0), (4, 0), (4, 3.5), (0, 3.5))):
-    """A room holding one instance per category (the catalog the search retrieves models from) and its walls."""
+    """A room holding one instance per category (the pool the search retrieves models from) and its walls."""
     r = Room(list(outline))
     for k, c in enumerate(categories):
         z = SIZES["nightstand"][2] if c == "table_lamp" else 0.0
@@ -42,7 +42,7 @@ def setup(categories, outline=((0, 0), (4, 0), (4, 3.5), (0, 3.5)), **overrides)
     ext = {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
     checker = Checker(r.models, set(r.models), {}, ext, intersector_class("embree"), ic["checks"])
     empty = with_objects(r.room_input(), [])
-    return empty, walls_of(empty), Catalog(r.objects_df(), {}), checker, ic
+    return empty, walls_of(empty), ModelPool(r.objects_df(), {}), checker, ic
 
 
 def bedroom_plan() -> ScenePlan:
@@ -61,11 +61,11 @@ AREAS = {"bed": 3.2, "nightstand": 0.2, "table_lamp": 0.04, "wardrobe": 0.6, "de
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_hand_built_bedroom_is_placed_and_its_extracted_graph_holds_every_planned_edge(seed):
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
     assert [plan.ids[k] for k in seq][:3] == ["bed", "ns_l", "ns_r"]  # the hub, then its spokes; supported last
-    out = instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), catalog, checker, ic, seed)
+    out = instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), pool, checker, ic, seed)
     assert out.ok, out.reason
     assert sorted(out.room.object_ids) == sorted(plan.ids)
     m = scene_metrics.consistency(plan, out.room, walls.ids, checker)  # a fresh extraction of the finished room
@@ -76,10 +76,10 @@ def test_hand_built_bedroom_is_placed_and_its_extracted_graph_holds_every_planne
 
 
 def test_same_seed_same_room():
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
-    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 5) for _ in range(2))
+    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), pool, checker, ic, 5) for _ in range(2))
     assert np.array_equal(a.room.boxes, b.room.boxes)
 
 
@@ -97,13 +97,13 @@ class PlantedCorner:
 
 
 def test_backtracking_recovers_from_a_planted_impossible_first_choice():
-    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"])
+    room, walls, pool, checker, ic = setup(["wardrobe", "desk"])
     plan = ScenePlan("s1", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1], [None, None],
                      ["none", "none"], [PlanEdge("wall_0", "w", "spatial", "front", "adjacent"),
                                         PlanEdge("wall_0", "d", "spatial", "front", "adjacent"),
                                         PlanEdge("w", "d", "spatial", "right", "adjacent")])
     proposer = Combined(PlantedCorner(), FaceAway())
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), proposer, catalog, checker, ic, 0)
+    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), proposer, pool, checker, ic, 0)
     assert not proposer.location.first  # the planted corner was proposed
     assert out.ok and out.backtracks >= 1, (out.reason, out.backtracks)
     w = out.room.boxes[out.room.object_ids.index("w")]
@@ -121,13 +121,13 @@ def _unsatisfiable():
 
 
 def test_an_unsatisfiable_graph_ends_with_a_failure_record_not_a_hang():
-    room, walls, catalog, checker, ic = setup(["bed"], NARROW, max_backtracks=6, restarts=2)
-    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
+    room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=6, restarts=2)
+    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
     assert not out.ok and "backtrack budget (6) spent: no place for b (bed)" in out.reason
     assert out.attempts == 3 and out.backtracks == 3 * 6  # every restart spent its own budget; the counts add up
     assert out.rejections > 0 and out.room.object_ids == []
     assert set(out.failures) == {"outside"}
-    once = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), catalog, checker,
+    once = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker,
                        {**ic, "restarts": 0}, 0)
     assert once.attempts == 1 and once.backtracks == 6 and 0 < once.rejections < out.rejections
 
@@ -135,26 +135,26 @@ def test_an_unsatisfiable_graph_ends_with_a_failure_record_not_a_hang():
 def test_a_scene_whose_first_search_spends_its_budget_is_placed_by_a_restart():
     """PlantedCorner's one bad proposal sinks the first attempt when no backtrack is allowed; the restart searches
     from scratch and places the scene with every planned edge."""
-    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"], max_backtracks=0)
+    room, walls, pool, checker, ic = setup(["wardrobe", "desk"], max_backtracks=0)
     plan = ScenePlan("s1", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1], [None, None],
                      ["none", "none"], [PlanEdge("wall_0", "w", "spatial", "front", "adjacent"),
                                         PlanEdge("wall_0", "d", "spatial", "front", "adjacent"),
                                         PlanEdge("w", "d", "spatial", "right", "adjacent")])
     seq = order.placement_order(plan, AREAS)
-    failed = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), catalog, checker,
+    failed = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), pool, checker,
                          {**ic, "restarts": 0}, 0)
     assert not failed.ok and failed.attempts == 1 and "backtrack budget (0) spent: no place for d" in failed.reason
-    out = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), catalog, checker, {**ic, "restarts": 2}, 0)
+    out = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), pool, checker, {**ic, "restarts": 2}, 0)
     assert out.ok and out.attempts == 2, out.reason
     assert out.rejections >= failed.rejections  # the failed attempt's rejections are counted too
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
 
 
 def test_restarts_leave_a_scene_placed_at_the_first_attempt_unchanged():
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
-    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), catalog, checker,
+    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), pool, checker,
                         {**ic, "restarts": n}, 1) for n in (0, 3))
     assert a.ok and b.ok and a.attempts == b.attempts == 1
     assert np.array_equal(a.room.boxes, b.room.boxes) and a.rejections == b.rejections
@@ -164,13 +164,13 @@ def test_restarts_leave_a_scene_placed_at_the_first_attempt_unchanged():
 def test_an_object_with_no_place_fails_the_scene_or_is_dropped_with_what_it_supports(mode):
     """The bed cannot fit the 1.4 m room; the lamp stands on it; the nightstand fits. PlanIT's search fails the
     scene; ``on_exhausted: drop`` leaves out the bed and its lamp, places the nightstand and says so."""
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"], NARROW, max_backtracks=6,
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"], NARROW, max_backtracks=6,
                                               on_exhausted=mode)
     plan = ScenePlan("s3", "r0", "bedroom", ["b", "n", "l"], ["bed", "nightstand", "table_lamp"],
                      ["left-right", "left-right", "radial"], [1, 1, 2], [None, None, "b"], ["none"] * 3,
                      [PlanEdge("wall_0", "b", "spatial", "front", "adjacent"),
                       PlanEdge("wall_0", "n", "spatial", "front", "adjacent"), PlanEdge("b", "l", "support", None, None)])
-    out = instantiate(plan, room, walls, [0, 1, 2], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
+    out = instantiate(plan, room, walls, [0, 1, 2], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
     if mode == "fail":
         assert out.status == "failed" and "no place for b (bed)" in out.reason and out.room.object_ids == []
     else:
@@ -185,10 +185,10 @@ def test_an_object_with_no_place_fails_the_scene_or_is_dropped_with_what_it_supp
 @pytest.mark.parametrize("mode", ["fail", "drop"])
 def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_crash(mode):
     """A held-out AI2-THOR bedroom held a vacuum cleaner, which no training bedroom did: the job crashed."""
-    room, walls, catalog, checker, ic = setup(["nightstand"], NARROW, on_exhausted=mode)
+    room, walls, pool, checker, ic = setup(["nightstand"], NARROW, on_exhausted=mode)
     plan = ScenePlan("s4", "r0", "bedroom", ["n", "v"], ["nightstand", "vacuum_cleaner"], ["left-right", "none"],
                      [1, 1], [None, None], ["none"] * 2, [PlanEdge("wall_0", "n", "spatial", "front", "adjacent")])
-    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
+    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
     if mode == "fail":
         assert out.status == "failed" and out.reason == "no training instance of category 'vacuum_cleaner' for v"
         assert out.room.object_ids == []  # failed before placing the nightstand
@@ -197,18 +197,18 @@ def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_c
 
 
 def test_the_time_budget_ends_a_scene_with_its_reason():
-    room, walls, catalog, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, time_budget=0.3)
-    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 0)
+    room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, time_budget=0.3)
+    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
     assert not out.ok and out.reason.startswith("time budget (0.3 s) spent")
 
 
 def test_an_l_shaped_room_keeps_furniture_inside_its_outline():
     outline = ((0, 0), (5, 0), (5, 2.5), (2.5, 2.5), (2.5, 5), (0, 5))
-    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"], outline)
+    room, walls, pool, checker, ic = setup(["wardrobe", "desk"], outline)
     plan = ScenePlan("s3", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1], [None, None],
                      ["none", "none"], [PlanEdge(walls.ids[2], "w", "spatial", "front", "adjacent"),
                                         PlanEdge(walls.ids[3], "d", "spatial", "front", "adjacent")])
-    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), catalog, checker, ic, 3)
+    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 3)
     assert out.ok, out.reason
     corners = footprint_corners(*out.room.boxes[:, [0, 1, 3, 4, 6]].T)
     assert (outside_area(np.array(outline, float), corners, ic["checks"]["outside"]) <= 1e-4).all()
@@ -240,10 +240,10 @@ def test_frames_round_trip_and_rename_sides():
 
 
 def test_the_glb_reloads_with_one_node_per_object_wall_and_the_floor(tmp_path):
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
-                      catalog, checker, ic, 0)
+                      pool, checker, ic, 0)
     scene = export.room_scene(out.room, walls, checker.meshes.get)
     path = export.write_glb(tmp_path / "s0.glb", out.room, walls, checker.meshes.get)
     back = trimesh.load(path)
@@ -335,7 +335,7 @@ def test_a_reflex_corner_piercing_a_footprint_is_out_of_bounds_for_the_check_and
     from pipeline.placement.checks import check
 
     outline = [(0, 0), (4.2, 0), (4.2, 4.7), (1.4, 4.7), (1.4, 3.0), (0, 3.0)]
-    room, walls, catalog, checker, ic = setup(["desk"], outline)
+    room, walls, pool, checker, ic = setup(["desk"], outline)
     verdicts, flags = [], []
     for x, y in ((1.85, 2.99), (2.8, 1.5)):
         r = Room(outline)
@@ -355,10 +355,10 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
     from pipeline.methods.planit.nets.train import build
     from pipeline.placement.search import Grid, anchors_of
 
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"])
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
-                      catalog, checker, ic, 0)
+                      pool, checker, ic, 0)
     bed_only = with_objects(out.room, [out.room.object_ids.index("bed")])
     preset = default_config()["placement"]["presets"]["tiny"]
     cats = ("bed", "nightstand", "table_lamp")
@@ -384,13 +384,13 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
 
 def _desk_right_of_a_wardrobe_flush_with_the_wall(early: bool):
     """A given wardrobe whose right side touches the right wall, and a desk planned adjacent to that side."""
-    room, walls, catalog, checker, ic = setup(["wardrobe", "desk"], max_backtracks=8, early_backtrack=early, restarts=0)
-    inst = catalog.pick("wardrobe", "left-right", np.random.default_rng(0))
+    room, walls, pool, checker, ic = setup(["wardrobe", "desk"], max_backtracks=8, early_backtrack=early, restarts=0)
+    inst = pool.pick("wardrobe", "left-right", np.random.default_rng(0))
     box, pose = place(inst, 4.0 - inst.half[0], 1.75, None, 0.0)  # yaw 0: its right side faces +x, on the wall
     room = add_object(room, "w", "wardrobe", inst.model_id, box, pose)
     plan = ScenePlan("s3", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1],
                      [None, None], ["none", "none"], [PlanEdge("w", "d", "spatial", "right", "adjacent")])
-    return instantiate(plan, room, walls, [1], Combined(RelationPrior(soft=1e-3), FaceAway()), catalog, checker, ic, 0)
+    return instantiate(plan, room, walls, [1], Combined(RelationPrior(soft=1e-3), FaceAway()), pool, checker, ic, 0)
 
 
 def test_early_backtrack_skips_the_samples_of_an_object_no_band_leaves_a_cell_for():
@@ -401,10 +401,10 @@ def test_early_backtrack_skips_the_samples_of_an_object_no_band_leaves_a_cell_fo
 
 
 def test_early_backtrack_still_places_the_hand_built_bedroom_with_every_planned_edge():
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"], early_backtrack=True)
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"], early_backtrack=True)
     plan = bedroom_plan()
     out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
-                      catalog, checker, ic, 0)
+                      pool, checker, ic, 0)
     assert out.ok, out.reason
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
 
@@ -416,9 +416,9 @@ def test_the_free_floor_kept_between_samples_follows_every_insertion_and_backtra
     from pipeline.placement.search import Search
 
     l_room = ((0, 0), (4, 0), (4, 2), (2, 2), (2, 4), (0, 4))
-    room, walls, catalog, checker, ic = setup(["bed", "nightstand", "table_lamp"], outline=l_room)
+    room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"], outline=l_room)
     plan = bedroom_plan()
-    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()), catalog,
+    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()), pool,
                checker, ic, np.random.default_rng(0))
     half = np.array([0.25, 0.2])
     empty = s.free_floor(half)

@@ -7,7 +7,7 @@ import pytest
 
 from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.stage import Files
-from pipeline.corpus import catalog, procedural
+from pipeline.corpus import furniture, procedural
 
 
 @pytest.fixture(scope="module")
@@ -37,9 +37,9 @@ def test_models_are_real_meshes_with_variants(models):
     _, rows = models
     df = pd.DataFrame(rows)
     per_cat = df.groupby("category").size()
-    assert (per_cat[list(catalog.CATEGORIES)] == 4).all()
+    assert (per_cat[list(furniture.CATEGORIES)] == 4).all()
     faces = df["faces"].apply(len) // 3
-    assert (faces[df.category.isin(list(catalog.CATEGORIES))] > 12).mean() > 0.85  # only books, radiators... are boxes
+    assert (faces[df.category.isin(list(furniture.CATEGORIES))] > 12).mean() > 0.85  # only books, radiators... are boxes
     bed = df[df.category == "bed"].iloc[0]
     v = np.asarray(bed["vertices"]).reshape(-1, 3)
     assert v[:, 2].min() == pytest.approx(0.0, abs=1e-6)  # origin at the bottom centre

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from pipeline.corpus import catalog
+from pipeline.corpus import furniture
 from pipeline.geometry import meshes, symmetry
 
 
@@ -10,14 +10,14 @@ from pipeline.geometry import meshes, symmetry
     ("dining_table", "rotational-2"), ("nightstand", "left-right"), ("sofa", "left-right"),
 ])
 def test_detects_catalogue_models(category, expected):
-    v, f, _ = catalog.build_model(category, 0, 0)
+    v, f, _ = furniture.build_model(category, 0, 0)
     assert symmetry.detect(v, f) == expected
 
 
 def test_agreement_with_construction_over_the_catalogue():
     results = []
-    for name, cat in catalog.CATEGORIES.items():
-        v, f, _ = catalog.build_model(name, 0, 0)
+    for name, cat in furniture.CATEGORIES.items():
+        v, f, _ = furniture.build_model(name, 0, 0)
         results.append(symmetry.detect(v, f) == cat.symmetry)
     assert np.mean(results) >= 0.9
 

@@ -24,7 +24,7 @@ from shapely.ops import unary_union
 
 from ..errors import InputError
 from ..geometry.polygon import make_ccw, merge_collinear, polygon_segments, segment_distances, segment_interval, signed_area
-from .future import Catalogue, MeshCache, norm_category
+from .future import FutureModels, MeshCache, norm_category
 from .ledger import Ledger
 from .rows import box_model_row, model_row, opening_row, room_row, wall_rows
 
@@ -33,7 +33,7 @@ log = logging.getLogger("planit.front3d")
 WORLD = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])  # Y-up world -> Z-up world
 OPENINGS = {"Door": "door", "Hole": "door", "Window": "window", "BayWindow": "window"}
 ARCHITECTURE_TITLES = ("door/", "window/")  # furniture entries that are openings, not furniture
-__all__ = ["Catalogue", "MeshCache", "HouseError", "parse_house", "norm_category"]
+__all__ = ["FutureModels", "MeshCache", "HouseError", "parse_house", "norm_category"]
 
 
 class HouseError(InputError):
@@ -115,9 +115,9 @@ def wall_mesh_coverage(segs: np.ndarray, footprints: list[np.ndarray], tolerance
 # ------------------------------------------------------------------------------------------- houses
 @dataclass
 class Context:
-    """What every house of one ingest job shares: the 3D-FUTURE catalogue and meshes, the ``front3d`` config,
+    """What every house of one ingest job shares: the 3D-FUTURE model table and meshes, the ``front3d`` config,
     the ledger, and the model rows built so far (one per model id, reported once per model)."""
-    catalogue: Catalogue
+    future_models: FutureModels
     meshes: MeshCache
     cfg: dict
     ledger: Ledger
@@ -317,7 +317,7 @@ def _object(house: House, path: str, child: dict, where: dict, ctx: Context) -> 
         return drop("no model id (jid)", f"{fpath}.jid")
     if furn.get("valid") is not True and title.startswith(ARCHITECTURE_TITLES):
         return drop("door or window entry: architecture, not furniture", f"{fpath}.title")
-    category = _category(furn, jid, ctx.catalogue)
+    category = _category(furn, jid, ctx.future_models)
     if category is None:
         return drop("no category (catalogue, title or super-category)", f"{fpath}.title")
     blocked = next((p for p in ctx.cfg["not_floor_objects"] if p in category or p in title), None)
@@ -341,15 +341,15 @@ def _object(house: House, path: str, child: dict, where: dict, ctx: Context) -> 
     return row
 
 
-def _category(furn: dict, jid: str, catalogue: Catalogue) -> str | None:
-    """The catalogue's fine category, else the furniture's own title (its part before ' - '), else the
-    catalogue's super-category, else the entry's category field. A coarse 'others' yields to the title."""
+def _category(furn: dict, jid: str, future_models: FutureModels) -> str | None:
+    """The model table's fine category, else the furniture's own title (its part before ' - '), else the
+    model table's super-category, else the entry's category field. A coarse 'others' yields to the title."""
     title = norm_category(furn.get("title"))
     title = title.split(" - ")[0].strip() if title else None
-    fine = catalogue.category.get(jid)
+    fine = future_models.category.get(jid)
     if fine and fine not in ("others", "other"):
         return fine
-    return title or fine or catalogue.super_category.get(jid) or norm_category(furn.get("category"))
+    return title or fine or future_models.super_category.get(jid) or norm_category(furn.get("category"))
 
 
 def _model(jid: str, category: str, house: House, fpath: str, ctx: Context) -> dict | None:
@@ -359,13 +359,13 @@ def _model(jid: str, category: str, house: House, fpath: str, ctx: Context) -> d
         return ctx.models[jid]
     mesh, problem = ctx.meshes.get(jid)
     if problem is not None:
-        status = "kept" if mesh is not None else ("fallback" if jid in ctx.catalogue.box else "dropped")
+        status = "kept" if mesh is not None else ("fallback" if jid in ctx.future_models.box else "dropped")
         ctx.ledger.drop("model", f"mesh {problem}", file=ctx.meshes.path(jid), house=house.uid, item=jid,
                         field=f"{fpath}.jid", status=status)
     if mesh is not None:
         ctx.models[jid] = model_row(jid, category, "front3d", mesh[0], mesh[1], "mesh", mesh[2])
-    elif jid in ctx.catalogue.box:
-        ctx.models[jid] = box_model_row(jid, category, "front3d", *ctx.catalogue.box[jid])
+    elif jid in ctx.future_models.box:
+        ctx.models[jid] = box_model_row(jid, category, "front3d", *ctx.future_models.box[jid])
         ctx.ledger[("model", "fallback", "box from Models.csv (no usable raw_model.obj)")] += 1
     else:
         ctx.models[jid] = None  # neither: looked up once, every object using it is dropped

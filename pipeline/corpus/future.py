@@ -1,4 +1,4 @@
-"""3D-FUTURE models: the catalogue (categories, boxes) and the furniture meshes, in the project's Z-up model space.
+"""3D-FUTURE models: the model table (categories, boxes) and the furniture meshes, in the project's Z-up model space.
 
 3D-FUTURE models face +z with Y up; model space here is ``(x, y, z) -> (-x, z, y)`` (front = +Y, Z up).
 """
@@ -27,14 +27,14 @@ def norm_category(name) -> str | None:
 
 
 @dataclass
-class Catalogue:
+class FutureModels:
     """3D-FUTURE model metadata: fine and super categories, boxes (model space, Z-up, metres)."""
     category: dict[str, str] = field(default_factory=dict)
     super_category: dict[str, str] = field(default_factory=dict)
     box: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
 
     @classmethod
-    def load(cls, future: Path, models_csv: Path | None, category_csv: Path | None, model_info: Path | None) -> "Catalogue":
+    def load(cls, future: Path, models_csv: Path | None, category_csv: Path | None, model_info: Path | None) -> "FutureModels":
         cat = cls()
         info = model_info or future / "model_info.json"
         if info.exists():

@@ -75,9 +75,9 @@ def ingest_front3d(config: dict, shard: int, shards: int) -> dict[str, pa.Table]
     if not future.is_dir():
         raise InputError(f"front3d.future: no such folder '{future}'")
     opt = lambda key: Path(cfg[key]) if cfg[key] else None  # noqa: E731
-    catalogue = front3d.Catalogue.load(future, opt("models_csv"), opt("category_csv"), opt("model_info"))
+    future_models = front3d.FutureModels.load(future, opt("models_csv"), opt("category_csv"), opt("model_info"))
     ledger = Ledger("front3d")
-    ctx = front3d.Context(catalogue, front3d.MeshCache(future, opt("cache_dir")), cfg, ledger, {})
+    ctx = front3d.Context(future_models, front3d.MeshCache(future, opt("cache_dir")), cfg, ledger, {})
     out = {"rooms": [], "architecture": [], "objects": []}
     for f in progress(files, desc=f"3D-FRONT houses, shard {shard}"):
         _house(front3d.parse_house, (f, ctx), f, out, ledger)

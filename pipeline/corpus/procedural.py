@@ -22,7 +22,7 @@ import shapely
 
 from ..geometry import boxes
 from ..geometry.polygon import inward_normals, polygon_segments, signed_area
-from . import catalog
+from . import furniture
 from .rows import model_row, opening_row, room_row, wall_rows
 
 ROOM_TYPES = ("bedroom", "living", "office", "bathroom", "kitchen")
@@ -90,11 +90,11 @@ def build_models(variants: int, seed: int) -> tuple[dict[str, list[Model]], list
     """Every catalogue model: per-category lists for the generator and rows of the ``models`` table."""
     by_cat: dict[str, list[Model]] = {}
     rows = []
-    for name in [*catalog.CATEGORIES, *catalog.RARE]:
-        n = variants if name in catalog.CATEGORIES else 1
+    for name in [*furniture.CATEGORIES, *furniture.RARE]:
+        n = variants if name in furniture.CATEGORIES else 1
         for k in range(n):
-            v, f, (w, d, h) = catalog.build_model(name, k, seed)
-            mid = catalog.model_id(name, k)
+            v, f, (w, d, h) = furniture.build_model(name, k, seed)
+            mid = furniture.model_id(name, k)
             by_cat.setdefault(name, []).append(Model(mid, name, w, d, h))
             rows.append(model_row(mid, name, "procedural", v, f))
     return by_cat, rows
@@ -109,7 +109,7 @@ def _overlap(a: shapely.Polygon, b: shapely.Polygon) -> bool:
 
 def _direction_label(anchor_category: str, local_xy: np.ndarray) -> str:
     """front/back/left/right of a point in an anchor's local frame (radial anchors: always front)."""
-    cat = catalog.CATEGORIES.get(anchor_category)
+    cat = furniture.CATEGORIES.get(anchor_category)
     if cat is not None and cat.symmetry == "radial":
         return "front"
     x, y = local_xy
@@ -676,7 +676,7 @@ def _apply_defect(r: RoomBuilder, defect: str) -> None:
         m = r.model("ottoman")
         r.add("ottoman", m, host.cx + float(r.rng.uniform(-0.05, 0.05)), host.cy, host.yaw)
     elif defect == "rare_category":
-        cat = catalog.RARE[r.index % len(catalog.RARE)]  # spread over the list so each stays rare
+        cat = furniture.RARE[r.index % len(furniture.RARE)]  # spread over the list so each stays rare
         m = r.model(cat)
         if r.free_group([(cat, m, 0.0, 0.0, 0.0)]) is None:
             c = r.outline.mean(axis=0)

@@ -13,7 +13,7 @@ from .checks import Checker, checks_config
 from .layout import walls_of, with_objects
 from .plan import plans_from_tables
 from .proposers import Combined, FaceAway, RelationPrior
-from .retrieval import Catalog
+from .retrieval import ModelPool
 from .search import instantiate
 
 
@@ -30,7 +30,7 @@ def reinstantiate(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.D
     ic = config["instantiate"]
     checker = Checker(meshes, box_models, symmetry, ext, intersector_class(ext["backend"]), checks_config(config))
     inputs = {r.room_id: r for r in room_inputs(rooms, architecture, objects)}
-    catalog = Catalog(objects, symmetry, config["floor_contact"])
+    pool = ModelPool(objects, symmetry, config["floor_contact"])
     areas = objects.assign(a=4 * objects["hx"] * objects["hy"]).groupby("category")["a"].mean().to_dict()
     rows = []
     for plan in plans:
@@ -39,7 +39,7 @@ def reinstantiate(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.D
         room = with_objects(inputs[plan.room_id], [])
         walls = walls_of(room)
         out = instantiate(plan, room, walls, order.placement_order(plan, areas), Combined(RelationPrior(), FaceAway()),
-                          catalog, checker, ic, seed)
+                          pool, checker, ic, seed)
         m = scene_metrics.consistency(plan, out.room, walls.ids, checker)
         rows.append({"room_id": plan.room_id, "objects": len(plan.ids), "placed": out.status == "placed", "reason": out.reason,
                      "seconds": out.seconds, "backtracks": out.backtracks, "attempts": out.attempts, **m,

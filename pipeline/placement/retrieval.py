@@ -23,7 +23,7 @@ class Instance:
     lift: float
 
 
-class Catalog:
+class ModelPool:
     """Instances per category (and symmetry) of the training rooms' objects."""
 
     def __init__(self, objects: pd.DataFrame, symmetry: dict[str, str], floor_contact: float = 0.05):

@@ -31,7 +31,7 @@ from .layout import add_object, box_frame, wall_frame, with_objects
 from .order import chains
 from .plan import PlanEdge, ScenePlan
 from .proposers import RelationPrior
-from .retrieval import Catalog, place
+from .retrieval import ModelPool, place
 
 log = logging.getLogger("planit.instantiate")
 
@@ -179,9 +179,9 @@ class Search:
     """One scene's search state."""
 
     def __init__(self, plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer,
-                 catalog: Catalog, checker: Checker, cfg: dict, rng: np.random.Generator):
+                 pool: ModelPool, checker: Checker, cfg: dict, rng: np.random.Generator):
         self.plan, self.walls, self.order = plan, walls, order
-        self.proposer, self.catalog, self.checker, self.cfg, self.rng = proposer, catalog, checker, cfg, rng
+        self.proposer, self.pool, self.checker, self.cfg, self.rng = proposer, pool, checker, cfg, rng
         self.fixed = len(room.object_ids)  # objects given (completion) are never moved
         self.room = room
         self.grid = Grid(room.outline, cfg["grid_mpp"])
@@ -207,7 +207,7 @@ class Search:
         elif k in self.unit:
             key = ("chain", self.unit[k], cat)
         if key not in self.shared:
-            self.shared[key] = self.catalog.pick(cat, self.plan.symmetry[k], self.rng)
+            self.shared[key] = self.pool.pick(cat, self.plan.symmetry[k], self.rng)
         return self.shared[key]
 
     def occupied(self, grow: float) -> np.ndarray:
@@ -315,7 +315,7 @@ class Search:
         for u, unit in enumerate(chains(self.plan)):
             for k in unit:
                 self.unit[k] = u
-        missing = {k for k in self.order if not self.catalog.has(self.plan.categories[k])}  # held-out categories
+        missing = {k for k in self.order if not self.pool.has(self.plan.categories[k])}  # held-out categories
         if missing and self.cfg["on_exhausted"] == "fail":  # no model to place: fail before placing anything
             k = next(k for k in self.order if k in missing)
             return f"no training instance of category '{self.plan.categories[k]}' for {self.plan.ids[k]}"
@@ -356,14 +356,14 @@ class Search:
         return ""
 
 
-def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, catalog: Catalog,
+def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, pool: ModelPool,
                 checker: Checker, cfg: dict, seed: int) -> Outcome:
     """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed). A search that
     spends its backtrack budget starts over, up to ``cfg['restarts']`` times: attempt ``a > 0`` draws from
     ``(seed, a)``, so the first attempt is the search without restarts. Counts and seconds add up over attempts."""
     start, runs = time.perf_counter(), []
     for attempt in range(cfg["restarts"] + 1):
-        s = Search(plan, room, walls, order, proposer, catalog, checker, cfg,
+        s = Search(plan, room, walls, order, proposer, pool, checker, cfg,
                    np.random.default_rng(seed if attempt == 0 else [seed, attempt]))
         reason = s.run(time.perf_counter() + cfg["time_budget"])
         runs.append(s)

@@ -22,7 +22,7 @@ from ...placement import order, proposers, scene_metrics
 from ...placement.checks import Checker, checks_config
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
-from ...placement.retrieval import Catalog
+from ...placement.retrieval import ModelPool
 from ...placement.search import instantiate
 from ..interface import Corpus, Scene, Task
 from .nets.proposer import NetProposer
@@ -35,7 +35,7 @@ log = logging.getLogger("planit.instantiate")
 class Context:
     """Everything the scenes of one room type share."""
     corpus: Corpus
-    catalog: Catalog
+    pool: ModelPool
     checker: Checker
     mean_area: dict
 
@@ -49,8 +49,8 @@ def load_context(config: dict, corpus: Corpus) -> Context:
     checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]),
                       checks_config(config))
     objs = corpus.objects
-    catalog = Catalog(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
-    return Context(corpus, catalog, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))
+    pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
+    return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))
 
 
 def make_proposer(location: str, saved, cfg: dict):
@@ -75,7 +75,7 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
     fixed = [plan.ids[k] for k in seq[:keep]]
     start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
     walls = walls_of(start)
-    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.catalog, ctx.checker, cfg, seed), walls
+    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.pool, ctx.checker, cfg, seed), walls
 
 
 def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
