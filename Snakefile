@@ -22,5 +22,7 @@ include: "rules/evaluate.smk"
 
 rule all:
     input:
-        get_final_outputs,
+        CORPUS_OUTPUTS,
+        learned_outputs,
+        RUNTIME,
     default_target: True

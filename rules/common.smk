@@ -33,6 +33,9 @@ try:  # the methods config lists: built in, or registered by generation.plugins
         planit_methods.get(_name)
 except Exception as exc:
     raise WorkflowError(f"generation.methods: {exc}") from None
+_clash = set(config["generation"]["methods"]) & {v for v, s in config["instantiate"]["variants"].items() if s["graphs"] == "heldout"}
+if _clash:
+    raise WorkflowError(f"generation.methods: {sorted(_clash)} also name Table 3 variants of instantiate.variants")
 ENV = "../environment.yml"
 
 
@@ -110,16 +113,17 @@ def method_keys(wildcards):
 
 
 # Every stage rule runs its subcommand (named as the rule) with its named input and output files as options.
-STAGE = "planit {rule} --config-json {params.config:q} {params.io} --threads {threads} 2> {log}"
+STAGE = "planit {params.io} --config-json {params.config:q} --threads {threads} 2> {log}"
 UNPASSED_WILDCARDS = {"corpus"}  # wildcards that only choose paths, not what a stage computes
 
 
 def stage_io(name):
-    """Params function of rule ``name``: ``--in-port path`` for each of its named inputs (repeated for lists),
-    ``--out-port path`` for each named output, ``--wildcard value`` for the wildcards the stage takes; the rule's
-    named files must be exactly the stage's declared ports (``pipeline.stages.STAGES``)."""
+    """Params function of the rule named ``name``. Gives the subcommand ``name``, then ``--port path`` for each of
+    its named inputs (repeated for lists), ``--out-port path`` for each named output, ``--wildcard value`` for the
+    wildcards the stage takes; the rule's named files must be exactly the stage's declared ports
+    (``pipeline.stages.STAGES``)."""
     if name not in STAGES:
-        raise WorkflowError(f"rule {name}: no stage of that name in pipeline.stages.STAGES")
+        raise WorkflowError(f"no stage in pipeline.stages.STAGES is named {name} (the rule of that name runs it)")
     stage = STAGES[name]
 
     def options(wildcards, input, output):
@@ -127,9 +131,9 @@ def stage_io(name):
             given, declared = set(files.keys()), {p.name for p in ports}
             required = {p.name for p in ports if not p.optional}
             if not required <= given <= declared:
-                raise WorkflowError(f"rule {name}: named {kind}s {sorted(given)}, but the stage declares "
+                raise WorkflowError(f"the rule {name} names {kind}s {sorted(given)}, but its stage declares "
                                     f"{sorted(declared)} ({sorted(required)} required)")
-        parts = []
+        parts = [name]
         for output, ports, files in ((False, stage.inputs, input), (True, stage.outputs, output)):
             for p in ports:
                 if p.name in files.keys():
@@ -214,12 +218,20 @@ def get_ablation_model(wildcards):
     return PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")
 
 
-def get_final_outputs(wildcards):
-    """Every output of the default run; the run-time table last, built once all the others exist."""
-    return [*pipeline_outputs(wildcards), RUNTIME]
+# The default run's outputs: those of every corpus stage (known when the workflow is parsed), those of the learned
+# room types (known once the room_types checkpoint has run), and the run-time table, built last.
+CORPUS_OUTPUTS = [
+    ROOM_TYPES,
+    FILTER_REPORT,
+    INGEST_REPORT,
+    DROPS,
+    *expand(METRICS, corpus="ingested", name=["extraction", "superstructures"]),
+    *expand(REPORT, corpus="ingested", name="table1.csv"),
+]
 
 
-def pipeline_outputs(wildcards):
+def learned_outputs(wildcards):
+    """Input function: the outputs of every learned room type (after the room_types checkpoint)."""
     types = graph_room_types()
     return [
         *expand(GRAPH_MODEL, room_type=types, name=["metrics.json", "loss.png"]),
@@ -227,10 +239,4 @@ def pipeline_outputs(wildcards):
         *expand(GENERATED, room_type=types, method=METHODS, name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
         *expand(EVAL, room_type=types, name="metrics.json"),
-        ROOM_TYPES,
-        FILTER_REPORT,
-        INGEST_REPORT,
-        DROPS,
-        *expand(METRICS, corpus="ingested", name=["extraction", "superstructures"]),
-        *expand(REPORT, corpus="ingested", name="table1.csv"),
     ]

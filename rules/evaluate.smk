@@ -42,7 +42,8 @@ rule evaluate:
 
 rule runtime:
     input:
-        done=pipeline_outputs,
+        corpus=CORPUS_OUTPUTS,
+        learned=learned_outputs,
     output:
         table=report(RUNTIME, caption="../report/runtime.rst", category="7. Run time"),
     params:

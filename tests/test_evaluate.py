@@ -210,7 +210,7 @@ def test_run_time_gathers_benchmarks_per_rule_and_the_wall_clock_span(tmp_path):
         tsv = tmp_path / rule / f"{job}.tsv"
         tsv.write_text(header + f"{seconds}\t0:00:00\t{rss}\t1\n")
         os.utime(tsv, (end, end))
-    table = runtime.run({}, Files(done=[]), Files(table=tmp_path / "out" / "runtime.csv"), benchmarks=str(tmp_path))
+    table = runtime.run({}, Files(corpus=[], learned=[]), Files(table=tmp_path / "out" / "runtime.csv"), benchmarks=str(tmp_path))
     rows = table.set_index("rule")
     assert rows.loc[runtime.WALL, "job_seconds"] == 30.0  # first start 990 (train), last end 1020
     assert rows.loc[runtime.TOTAL, "job_seconds"] == 18.0 and rows.loc[runtime.TOTAL, "jobs"] == 3

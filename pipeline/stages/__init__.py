@@ -113,7 +113,8 @@ _ALL = [
                    one("gallery", "folder of generated and real rooms (PNG, GLB)")), params=(ROOM_TYPE,),
           threads=True),
     Stage("runtime", "Job seconds and peak memory per rule from the benchmark files, and the run's wall-clock span.",
-          inputs=(many("done", "the outputs whose jobs are timed (read for their presence only)"),),
+          inputs=(many("corpus", "the corpus stages' outputs (their jobs are timed; read for their presence)"),
+                  many("learned", "the learned room types' outputs (likewise)")),
           outputs=(one("table", "runtime.csv"),),
           params=(Param("benchmarks", str, "benchmarks", "Snakemake's benchmark folder"),)),
 ]
