@@ -10,10 +10,10 @@ import pandas as pd
 
 from .. import tables
 from ..errors import InputError
+from ..placement.search import SCORED
 from ..room import RoomInput, room_inputs
 
 REAL = "real_heldout"
-SCORED = ("placed", "partial")  # scenes whose rooms are scored (failed ones are counted, not scored)
 
 
 @dataclass

@@ -10,7 +10,7 @@ from ..evaluation import render
 from ..placement.layout import walls_of
 from ..room import RoomInput, room_inputs
 from .interface import Scene, Task
-from .scenes import SCORED
+from ..placement.search import SCORED
 
 
 class Retrieval:

@@ -11,11 +11,11 @@ import pandas as pd
 
 from .. import tables
 from ..placement import export
+from ..placement.search import SCORED
+from ..room import BOX_COLUMNS
 from .interface import Corpus, Scene
 
 log = logging.getLogger("planit.generate")
-SCORED = ("placed", "partial")  # scenes whose rooms are scored (failed ones are counted, not scored)
-OBJECT_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
 
 
 @dataclass
@@ -38,7 +38,7 @@ class Rows:
         arch = corpus.architecture[corpus.architecture["room_id"] == scene.source_room_id]
         self.architecture += tables.records(arch.assign(room_id=scene.scene_id))
         self.objects += [{"room_id": scene.scene_id, "scene_id": scene.scene_id, "object_id": o, "category": c,
-                          "model_id": m, **dict(zip(OBJECT_COLUMNS, map(float, b))),
+                          "model_id": m, **dict(zip(BOX_COLUMNS, map(float, b))),
                           **dict(zip(["px", "py", "pz", "_yaw", "sx", "sy", "sz"], map(float, p))),
                           "source_parent_id": scene.parents.get(o)}
                          for o, c, m, b, p in zip(room.object_ids, room.categories, room.model_ids, room.boxes,
