@@ -237,6 +237,9 @@ SCHEMAS["eval_scenes"] = pa.schema([
     _f("nn_room_id", _STR, doc="that training room"),
     _f("consistency", _F64, doc="instantiation's graph consistency (null for real rooms)"),
     _f("violation", _F64, doc="instantiation's violation cost (null for real rooms)"),
+    _f("contents_excess", _F64, doc="1: a category more often than in any training room of the type"),
+    _f("contents_missing", _F64, doc="1: a category missing that the training rooms hold with confidence"),
+    _f("functional_all", _F64, doc="1: every applicable functional check passes and the contents are plausible"),
 ])
 SCHEMAS["superstructures"] = pa.schema([
     _f("room_id", _STR, nullable=False), _f("room_type", _CAT),

@@ -21,8 +21,12 @@ rule evaluate:
     output:
         metrics=EVAL.replace("{name}", "metrics.json"),
         scenes=EVAL.replace("{name}", "scenes.parquet"),
-        table=report(EVAL.replace("{name}", "metrics.csv"), caption="../report/evaluation.rst", category="5. Evaluation",
-                     subcategory="{room_type}", labels={"room type": "{room_type}", "figure": "metrics"}),
+        table=EVAL.replace("{name}", "metrics.csv"),
+        table_html=report(EVAL.replace("{name}", "metrics.html"), caption="../report/evaluation.rst",
+                          category="5. Evaluation", subcategory="{room_type}",
+                          labels={"room type": "{room_type}", "figure": "metrics"}),
+        power=report(EVAL.replace("{name}", "power.png"), caption="../report/power.rst", category="5. Evaluation",
+                     subcategory="{room_type}", labels={"room type": "{room_type}", "figure": "classifier power"}),
         gallery=report(directory(EVAL.replace("{name}", "gallery")), patterns=["{name}.png"],
                        caption="../report/gallery.rst", category="6. Gallery", subcategory="{room_type}",
                        labels={"room type": "{room_type}", "room": "{name}"}),
@@ -45,7 +49,8 @@ rule runtime:
         corpus=CORPUS_OUTPUTS,
         learned=learned_outputs,
     output:
-        table=report(RUNTIME, caption="../report/runtime.rst", category="7. Run time"),
+        table=RUNTIME,
+        table_html=report(RUNTIME_HTML, caption="../report/runtime.rst", category="7. Run time"),
     params:
         config=keys(),
         io=stage_io("runtime"),

@@ -7,7 +7,9 @@ checkpoint room_types:
     input:
         nodes=GATHERED.format(corpus="ingested", table="nodes"),
     output:
-        table=report(ROOM_TYPES, caption="../report/room_types.rst", category="2. Graphs"),
+        table=ROOM_TYPES,
+        table_html=report(ROOM_TYPES_HTML, caption="../report/room_types.rst", category="2. Graphs",
+                          labels={"corpus": "ingested", "figure": "room types"}),
     params:
         config=keys("graph_model.room_types", "source", "procedural.rooms", "filter.min_floor_objects"),
         io=stage_io("room_types"),

@@ -69,7 +69,8 @@ rule filter_report:
         reports=shards_of(FILTER_SHARD_REPORT),
     output:
         report=FILTER_REPORT,
-        counts=report(RULE_COUNTS, caption="../report/filter_counts.rst", category="1. Ingest and filter"),
+        counts=RULE_COUNTS,
+        counts_html=report(RULE_COUNTS_HTML, caption="../report/filter_counts.rst", category="1. Ingest and filter"),
     params:
         config=keys(),
         io=stage_io("filter_report"),

@@ -155,8 +155,9 @@ rule table3:
     input:
         summaries=expand(ABLATION, variant=TABLE3_VARIANTS, name="summary.json", allow_missing=True),
     output:
-        table=report(TABLE3, caption="../report/table3.rst", category="4. Instantiation (Table 3)",
-                     labels={"room type": "{room_type}"}),
+        table=TABLE3,
+        table_html=report(TABLE3_HTML, caption="../report/table3.rst", category="4. Instantiation (Table 3)",
+                          labels={"room type": "{room_type}"}),
     params:
         config=keys(),
         io=stage_io("table3"),

@@ -116,11 +116,13 @@ rule graph_report:
         edges=GATHERED.replace("{table}", "edges"),
         superstructures=GATHERED.replace("{table}", "superstructures"),
     output:
-        table1=report(REPORT.replace("{name}", "table1.csv"), caption="../report/table1.rst", category="2. Graphs",
-                      labels={"corpus": "{corpus}", "figure": "Table 1"}),
-        pruning=report(REPORT.replace("{name}", "pruning.csv"), caption="../report/pruning.rst", category="2. Graphs",
-                       labels={"corpus": "{corpus}", "figure": "pruning"}),
+        table1=REPORT.replace("{name}", "table1.csv"),
+        pruning=REPORT.replace("{name}", "pruning.csv"),
         relations=REPORT.replace("{name}", "relations.csv"),
+        table1_html=report(REPORT.replace("{name}", "table1.html"), caption="../report/table1.rst", category="2. Graphs",
+                           labels={"corpus": "{corpus}", "figure": "Table 1"}),
+        pruning_html=report(REPORT.replace("{name}", "pruning.html"), caption="../report/pruning.rst",
+                            category="2. Graphs", labels={"corpus": "{corpus}", "figure": "pruning"}),
         plot=report(REPORT.replace("{name}", "graph_stats.png"), caption="../report/graph_stats.rst", category="2. Graphs",
                     labels={"corpus": "{corpus}", "figure": "edges per node"}),
     params:

@@ -136,7 +136,8 @@ def test_a_pair_the_coarse_per_attempt_grid_clears_is_measured_again_the_evaluat
     r.add("a", "cabinet", (1.0, 1.0, 1.0), (1.5, 2.0))
     r.add("b", "cabinet", (1.0, 1.0, 1.0), (2.485, 2.3))
     room, ext = r.room_input(), {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
-    screen = {"measure": "mesh", "resolution": 4, "min_pitch": 0.04, "max_cells": 1000}
+    screen = {**cfg["instantiate"]["checks"]["penetration"], "resolution": 4, "min_pitch": 0.04, "max_cells": 1000,
+              "surface_spacing": None}  # a grid alone, which misses the 1.5 cm slab
     checks = {**checks_config(cfg), "penetration": screen}
     assert checks_config(cfg)["confirm"] == cfg["evaluate"]["collision"]["penetration"]
     assert check_collision(room, 1, set(), Checker(r.models, set(), {}, ext, EMBREE, {**checks, "confirm": None})) is None
@@ -144,3 +145,95 @@ def test_a_pair_the_coarse_per_attempt_grid_clears_is_measured_again_the_evaluat
     assert hit is not None and hit[0] == 0 and hit[1] == pytest.approx(0.015, abs=0.0065)  # one pitch: 6 mm here
     ev = {**cfg["evaluate"]["collision"], "intersector": EMBREE}
     assert physical.colliding(room, [None, None], [r.models[m] for m in room.model_ids], ev).all()
+
+
+# ------------------------------------------------------------------------ thin parts (issue 27): bookshelves
+def bookshelf(shelves=5, width=0.8, depth=0.35, height=1.8, panel=0.02):
+    """Two side panels, a bottom, a top and ``shelves`` shelves between them, 2 cm box panels concatenated (model
+    frame: bottom centre at the origin)."""
+    side = [meshes.box((panel, depth, height), (s * (width - panel) / 2, 0, height / 2)) for s in (-1, 1)]
+    step = (height - panel) / (shelves + 1)
+    flat = [meshes.box((width - 2 * panel, depth, panel), (0, 0, panel / 2 + k * step)) for k in range(shelves + 2)]
+    return meshes.combine(side + flat)
+
+
+def shifted(mesh, offset):
+    return mesh[0] + np.asarray(offset, float), mesh[1]
+
+
+SPACING = (1.8 - 0.02) / 6  # between the 5-shelf bookcase's panels
+LIMIT = _C["evaluate"]["collision"]["max_penetration"]  # 1 cm: what the evaluation and the placement checks allow
+SETTINGS = {"evaluate": _C["evaluate"]["collision"]["penetration"], "instantiate": _C["instantiate"]["checks"]["penetration"],
+            "filter": PEN}
+
+
+def _grid_only(pen):
+    """The measure before issue 27: the grid over the boxes' overlap alone."""
+    return {**pen, "surface_spacing": None}
+
+
+@pytest.mark.parametrize("setting", ["evaluate", "instantiate"])
+@pytest.mark.parametrize("shelves, offset", [
+    (5, (0.4, 0.0, SPACING / 2)),  # half a spacing up, half a width across: side panels cut the other's shelves
+    (5, (0.3, 0.05, SPACING / 2)),
+    (5, (0.5, 0.1, SPACING / 3)),
+    (4, (0.4, 0.0, 0.0)),  # both on the floor, 4 and 5 shelves: bottoms and tops coincide in part, sides cut shelves
+    (4, (0.5, 0.05, 0.0)),
+])
+def test_bookshelves_whose_panels_interleave_penetrate_by_a_panel_the_grid_alone_missed(setting, shelves, offset):
+    """The issue's case: the boxes overlap 0.3-0.5 x 0.3 x 1.7 m, so the grid's pitch is 5-6 cm and none of its points
+    falls inside both 2 cm panels (it read 0: no collision); the surface screen finds where the surfaces cross and
+    measures the panel there, about its 2 cm thickness."""
+    pen = SETTINGS[setting]
+    a, b = bookshelf(), shifted(bookshelf(shelves), offset)
+    lo, hi = collision.box_overlap(a[0].min(0), a[0].max(0), b[0].min(0), b[0].max(0))
+    assert collision.grid(lo, hi, pen["resolution"], pen["min_pitch"], pen["max_cells"])[1] > 0.04
+    assert collision.mesh_penetration(a, b, EMBREE, _grid_only(pen)) < LIMIT
+    assert collision.mesh_penetration(a, b, EMBREE, pen) == pytest.approx(0.02, abs=pen["min_pitch"])
+
+
+def test_bookshelves_apart_or_one_inside_the_others_compartment_do_not_penetrate():
+    """Side by side 1 cm apart, flush against each other, and a small shelf (0.3 x 0.25 x 0.2 m) standing in the
+    big one's bottom compartment, 1 cm above its bottom panel and 10 cm below the first shelf: its box lies wholly
+    inside the big one's, its mesh touches nothing."""
+    a = bookshelf()
+    small = shifted(bookshelf(shelves=0, width=0.3, depth=0.25, height=0.2), (0.0, 0.0, 0.03))
+    for pen in SETTINGS.values():
+        assert collision.mesh_penetration(a, shifted(a, (0.81, 0.0, 0.0)), EMBREE, pen) == 0.0
+        assert collision.mesh_penetration(a, shifted(a, (0.8, 0.0, 0.0)), EMBREE, pen) < LIMIT
+        assert collision.mesh_penetration(a, small, EMBREE, pen) == 0.0
+
+
+def test_interleaved_bookshelves_collide_for_the_placement_checks_the_filter_and_the_evaluation():
+    """One measure serves all three (geometry.collision.penetrating_pairs): two bookshelves standing on the floor,
+    4 and 5 shelves, 0.4 m apart, collide for the placement checks and the evaluation and, at a 1 cm limit, for the
+    filter; with the grid alone (surface_spacing null everywhere) none of the three saw it."""
+    from pipeline.evaluation import physical
+    from pipeline.placement.checks import Checker, checks_config, collision as check_collision
+
+    def room():
+        r = _living()
+        r.add("shelf_a", "bookcase", (0.8, 0.35, 1.8), (3.0, 3.0), mesh=bookshelf())
+        return r.add("shelf_b", "bookcase", (0.8, 0.35, 1.8), (3.4, 3.0), mesh=bookshelf(4))
+
+    def verdicts(cfg):
+        r = room()
+        room_in, ext = r.room_input(), {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
+        placed = check_collision(room_in, 4, set(), Checker(r.models, set(), {}, ext, EMBREE, checks_config(cfg)))
+        ev = {**cfg["evaluate"]["collision"], "intersector": EMBREE}
+        evaluated = physical.colliding(room_in, [None] * 5, [r.models[m] for m in room_in.model_ids], ev)
+        rooms = pd.DataFrame([dict(vars(r.row()), shard=0)])
+        flt = {**cfg["filter"], "floor_contact": cfg["floor_contact"], "intersector": EMBREE, "max_penetration": LIMIT}
+        kept = filter_rooms(rooms, r.walls(), r.objects_df(), flt, category_room_counts(rooms, r.objects_df()), r.models)
+        return placed, evaluated[3:].tolist(), kept.iloc[0]
+
+    placed, evaluated, kept = verdicts(_C)
+    assert placed is not None and placed[0] == 3 and placed[1] == pytest.approx(0.02, abs=0.005)
+    assert evaluated == [True, True]
+    assert kept.rule == "interpenetration" and "(meshes)" in kept.detail and "shelf_a and shelf_b" in kept.detail
+    off = {"surface_spacing": None}
+    grid_only = config.validate({"filter": {"min_category_rooms": 1, "penetration": off},
+                                 "instantiate": {"checks": {"penetration": off}},
+                                 "evaluate": {"collision": {"penetration": off}}})
+    placed, evaluated, kept = verdicts(grid_only)
+    assert placed is None and evaluated == [False, False] and kept.status == "kept"

@@ -122,7 +122,7 @@ def test_environment_yml_matches_pyproject():
 @pytest.mark.parametrize("name", ["tiny", "front3d", "ithor", "paper"])
 def test_every_shipped_config_validates_over_the_defaults(name):
     cfg = config.load(ROOT / "config" / f"{name}.yaml")
-    assert cfg["seed"] is not None and cfg["evaluate"]["sca"]["runs"] >= 1
+    assert cfg["seed"] is not None and cfg["evaluate"]["sca"]["steps"] >= 1
     if name == "paper":
         assert cfg["graph_model"]["preset"] == cfg["placement"]["preset"] == "paper"
         assert cfg["placement"]["presets"]["paper"]["size"] == 256

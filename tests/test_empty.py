@@ -58,8 +58,11 @@ def test_a_room_type_with_too_few_rooms_is_skipped_with_its_reason(tmp_path):
             for t, n in (("bedroom", 3), ("office", 2)) for k in range(n)]
     tables.write(tmp_path / "nodes.parquet", "final_nodes", tables.from_rows("final_nodes", rows))
     cfg = config.validate({"graph_model": {"room_types": ["bedroom", "office", "kitchen"]}})
-    room_types.run(cfg, Files(nodes=tmp_path / "nodes.parquet"), Files(table=tmp_path / "types.csv"))
+    room_types.run(cfg, Files(nodes=tmp_path / "nodes.parquet"),
+                   Files(table=tmp_path / "types.csv", table_html=tmp_path / "types.html"))
     got = pd.read_csv(tmp_path / "types.csv", keep_default_na=False).set_index("room_type")
     assert got.status.to_dict() == {"bedroom": "learned", "office": "skipped", "kitchen": "skipped"}
     assert got.loc["office", "reason"] == "2 room(s); training needs 3"
     assert got.loc["kitchen", "reason"] == "no room of this type passed the filter"
+    html = (tmp_path / "types.html").read_text()  # the report's table: the same rows
+    assert html.count("<tr>") == 4 and "no room of this type passed the filter" in html

@@ -1,5 +1,6 @@
 """A minimal W3C WebDriver client over chromedriver's HTTP API (the standard library only): enough to open a page in
-headless Chromium (Debian's chromium + chromium-driver), click, run a script and take a screenshot."""
+headless Chromium (Debian's chromium + chromium-driver), click, switch into an iframe, run a script and take a
+screenshot."""
 from __future__ import annotations
 
 import base64
@@ -15,6 +16,7 @@ CHROMIUM, CHROMEDRIVER = shutil.which("chromium"), shutil.which("chromedriver")
 # no background networking: this machine's closed network refuses it (and it slows every start)
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync", "--window-size=1400,1000"]
+ELEMENT = "element-6066-11e4-a52e-4f735466cecf"  # the W3C key of an element reference
 
 
 class Browser:
@@ -51,9 +53,16 @@ class Browser:
     def elements(self, css: str) -> list[str]:
         return [next(iter(e.values())) for e in self.do("POST", "/elements", {"using": "css selector", "value": css})]
 
+    def find(self, xpath: str) -> str:
+        """The first element matching ``xpath`` (an error when none does)."""
+        return next(iter(self.do("POST", "/element", {"using": "xpath", "value": xpath}).values()))
+
+    def frame(self, element: str | None) -> None:
+        """Switch into an iframe (one of :meth:`elements`), or back to the top-level page with None."""
+        self.do("POST", "/frame", {"id": None if element is None else {ELEMENT: element}})
+
     def click_text(self, text: str) -> None:
-        el = self.do("POST", "/element", {"using": "xpath", "value": f"//*[normalize-space(text())='{text}']"})
-        self.click(next(iter(el.values())))
+        self.click(self.find(f"//*[normalize-space(text())='{text}']"))
 
     def click(self, element: str) -> None:
         self.do("POST", f"/element/{element}/click", {})

@@ -1,55 +1,94 @@
 """Score every method's rooms of one room type and the held-out real rooms by the same functions: per scene the
-physical metrics, walkability and nearest-training-room similarity; per set the category and object-count distances
-beside their sampling floors, the collision, out-of-bounds and walkability rates, graph consistency and the
-real-vs-synthetic classifier accuracy."""
+physical metrics, walkability, nearest-training-room similarity and the functional checks learned from the training
+rooms; per set the category and object-count distances beside their sampling floors, the collision, out-of-bounds
+and walkability rates, graph consistency and the functional checks' shares, each with a bootstrap 95% interval and
+its difference from the first method and from the real rooms; the real-vs-synthetic classifier's accuracy after its
+power check."""
 from __future__ import annotations
+
+from collections import Counter
 
 import pandas as pd
 
 from .. import tables
 from ..geometry.raycast import intersector_class
 from ..placement.checks import Checker
-from . import render
-from .scores import finite, floors, goals, label_maps, rule_satisfaction, scene_rows, set_summary, train_similarity
+from . import functional, intervals, power, render
+from .scores import finite, floors, goals, label_maps, rule_satisfaction, scene_rows, set_counts, train_similarity
 from .sets import REAL, RoomSet
 
-SETTINGS = ("render", "walk", "collision", "out_of_bounds", "sca", "kl_eps")
+SETTINGS = ("render", "walk", "collision", "out_of_bounds", "sca", "kl_eps", "functional", "power", "bootstrap",
+            "bootstrap_min_rooms")
+EXTRA = ["consistency", "violation", "nn_similarity", "contents_excess", "contents_missing", "functional_all"]
 
 
 def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: RoomSet, real: RoomSet, meshes: dict,
                        box_models: set, symmetry: dict, threads: int = 1) -> tuple[dict, pd.DataFrame]:
     """``metrics.json``'s content and the ``eval_scenes`` rows of every set (``gen``: the methods' sets, the first
-    one's goals reported)."""
+    one the reference of the differences and the goals)."""
     ev = config["evaluate"]
     index = {c: k for k, c in enumerate(sorted({c for s in (train, real, *gen) for r in s.rooms for c in r.categories}))}
     train_maps = label_maps(train, index, ev["render"])
-    train_ids = [r.room_id for r in train.rooms]
+    learned = functional.learn_checks(train.rooms, ev["functional"])
     by_name = {rs.name: rs for rs in (*gen, real)}
-    rows = {name: pd.DataFrame(scene_rows(rs, meshes, box_models, train_maps, train_ids, index, config),
-                               columns=tables.SCHEMAS["eval_scenes"].names) for name, rs in by_name.items()}
-    sets = {name: set_summary(frame, by_name[name], real, ev["kl_eps"]) for name, frame in rows.items()}
-    for name, score in classifier_scores(config, by_name, train_maps, real, index, threads).items():
-        sets[name]["sca"] = score
+    rows = {name: room_rows(rs, learned, index, meshes, box_models, train_maps, [r.room_id for r in train.rooms],
+                            config) for name, rs in by_name.items()}
+    checks = [functional.check_name(c) for c in learned["checks"]]
+    stat = lambda frame, ref: intervals.figures(frame, ref, ev["kl_eps"], EXTRA + checks)
+    reps = intervals.bootstrap(rows, REAL, stat, ev["bootstrap"], config["seed"])
+    spans = intervals.intervals(reps)
+    sets = {name: {**set_counts(rows[name], rs), **stat(rows[name], rows[REAL]), "intervals": spans[name]}
+            for name, rs in by_name.items()}
+    sca, check = classifier_scores(config, by_name, train, real, index, threads)
+    for name, score in sca.items():
+        if name in sets:
+            sets[name]["sca"] = score
     if config["source"] == "procedural":  # the generator's own rules: an oracle only for its rooms
         checker = Checker(meshes, box_models, symmetry, {**config["extract"], "floor_contact": config["floor_contact"]},
                           intersector_class(config["extract"]["backend"]), {})
         for name, rs in by_name.items():
             sets[name]["rules"] = rule_satisfaction(rs, checker)
     fl = floors(train, real, len(gen[0].rooms), ev, config["seed"])
-    metrics = finite({"room_type": room_type, "sets": sets, "floors": fl,
-                      "train_nn_similarity": train_similarity(train_maps, ev["similarity_sample"], config["seed"]),
-                      "goals": goals(sets, fl, gen[0].name, REAL), "real_train_rooms": len(train.rooms),
-                      "settings": {k: ev[k] for k in SETTINGS}, "categories": sorted(index)})
-    return metrics, pd.concat(list(rows.values()), ignore_index=True)
+    metrics = {"room_type": room_type, "sets": sets, "floors": fl, "functional": learned, "checks": checks,
+               "differences": {f"vs_{ref}": intervals.differences(reps, ref, {n: len(f) for n, f in rows.items()},
+                                                                   ev["bootstrap_min_rooms"]) for ref in (gen[0].name, REAL)},
+               "power": {"scores": {k: v for k, v in sca.items() if k not in sets}, **check},
+               "train_nn_similarity": train_similarity(train_maps, ev["similarity_sample"], config["seed"]),
+               "real_train_rooms": len(train.rooms), "settings": {k: ev[k] for k in SETTINGS},
+               "categories": sorted(index)}
+    metrics["goals"] = goals(metrics, gen[0].name, REAL)
+    scenes = pd.concat([f[tables.SCHEMAS["eval_scenes"].names] for f in rows.values()], ignore_index=True)
+    return finite(metrics), scenes
 
 
-def classifier_scores(config: dict, by_name: dict, train_maps, real: RoomSet, index: dict, threads: int) -> dict:
-    """The real-vs-synthetic classifier's accuracy for every generated set (trained from scratch per set)."""
+def room_rows(rs: RoomSet, learned: dict, index: dict, meshes: dict, box_models: set, train_maps, train_ids: list[str],
+              config: dict) -> pd.DataFrame:
+    """One row per room: the ``eval_scenes`` columns, each functional check's outcome and the category counts."""
+    scored = pd.DataFrame(scene_rows(rs, meshes, box_models, train_maps, train_ids, index, config),
+                          columns=[c for c in tables.SCHEMAS["eval_scenes"].names if c not in functional.ROOM_COLUMNS])
+    fn = pd.DataFrame([functional.score_room(r, learned, config["evaluate"]["functional"]) for r in rs.rooms],
+                      index=scored.index)
+    counts = pd.DataFrame([Counter(r.categories) for r in rs.rooms], index=scored.index,
+                          columns=sorted(index)).fillna(0).add_prefix(intervals.CATEGORY)
+    return pd.concat([scored, fn, counts], axis=1)
+
+
+def classifier_scores(config: dict, by_name: dict, train: RoomSet, real: RoomSet, index: dict,
+                      threads: int) -> tuple[dict, dict]:
+    """The classifier's accuracy for every generated set, every power set and the real-vs-real control, and the
+    power check's verdict."""
     from .sca import sca_scores
 
     ev = config["evaluate"]
     colours = render.palette(sorted(index))
-    real_maps = (render.to_rgb(train_maps, colours), render.to_rgb(label_maps(real, index, ev["render"]), colours))
-    return {name: sca_scores(real_maps, render.to_rgb(label_maps(rs, index, ev["render"]), colours), ev["sca"],
-                             threads, config["seed"])
-            for name, rs in by_name.items() if name != REAL}
+    rgb = lambda rooms: render.classifier_images(rooms, index, colours, ev["render"])
+    real_test = rgb(real.rooms)
+    known = power.power_sets(real.rooms, ev["power"], config["seed"])
+    sets = {name: (rgb(rs.rooms), None) for name, rs in by_name.items() if name != REAL}
+    sets |= {name: (rgb(rooms), groups) for name, (rooms, groups) in known.items()}
+    scores = sca_scores((rgb(train.rooms), real_test), sets, ev["sca"], threads, config["seed"])
+    size = max(len(rs.rooms) for rs in by_name.values())  # as many as the largest set scored (half the training rooms at most)
+    kept, back = power.control_split(train.rooms, size, config["seed"])
+    scores |= sca_scores((rgb(kept), real_test), {power.CONTROL: (rgb(back), None)}, ev["sca"], threads,
+                         config["seed"])
+    return scores, power.verdict(scores, ev["power"])

@@ -1,7 +1,8 @@
 """Top-down category renders for the evaluation (the ThreedFront toolkit's convention): white background, no floor,
 each object filled with its category's colour from a fixed HLS palette (one hue per category, lightness 0.6,
 saturation 0.65), higher objects drawn over lower ones; a square window centred on the room's bounding box. A render
-is kept as a label map (category index per pixel, -1 empty): colours for the classifier, labels for similarity."""
+is kept as a label map (category index per pixel, -1 empty) for the layout similarity. The classifier's renders add
+the floor and each object's front, and fit each room to the window (:func:`classifier_map`, :func:`fitted_mpp`)."""
 from __future__ import annotations
 
 import colorsys
@@ -11,9 +12,10 @@ import numpy as np
 
 from ..room import RoomInput
 from ..geometry import boxes
-from ..geometry.raster import fill_quads
+from ..geometry.raster import fill_polygon, fill_quads
 
 EMPTY = -1
+FLOOR = -2
 
 
 def palette(categories: Sequence[str]) -> np.ndarray:
@@ -36,12 +38,46 @@ def label_map(room: RoomInput, index: dict[str, int], size: int, mpp: float) -> 
     return out
 
 
-def to_rgb(labels: np.ndarray, colors: np.ndarray) -> np.ndarray:
-    """``(..., size, size, 3)`` float32 image of label maps ``(..., size, size)``: white where empty."""
+def classifier_map(room: RoomInput, index: dict[str, int], size: int, mpp: float, front: float) -> np.ndarray:
+    """``(size, size)`` int16 render for the real-vs-synthetic classifier (a departure from the toolkit's renders,
+    which show neither the floor nor which way an object faces): the floor ``FLOOR``, each object its category
+    index ``k`` and the front ``front`` share of its footprint ``k + len(index)``, higher objects over lower ones."""
+    centre = (room.outline.min(0) + room.outline.max(0)) / 2
+    out = np.where(fill_polygon(room.outline, size, mpp, centre), FLOOR, EMPTY).astype(np.int16)
+    b = room.boxes
+    for k in np.argsort(b[:, 2] + b[:, 5], kind="stable") if len(b) else []:
+        if room.categories[k] in index:
+            cx, cy, hx, hy, yaw = b[k, 0], b[k, 1], b[k, 3], b[k, 4], b[k, 6]
+            fill_quads(out, boxes.footprint_corners(cx, cy, hx, hy, yaw), index[room.categories[k]], mpp, centre)
+            shift = (1.0 - front) * hy  # the front strip's centre, along the object's local +y
+            fill_quads(out, boxes.footprint_corners(cx - shift * np.sin(yaw), cy + shift * np.cos(yaw), hx, front * hy,
+                                                    yaw), index[room.categories[k]] + len(index), mpp, centre)
+    return out
+
+
+def classifier_rgb(labels: np.ndarray, colors: np.ndarray) -> np.ndarray:
+    """``(..., size, size, 3)`` float32 image of :func:`classifier_map` renders: white outside the room, light grey
+    floor, category colours, their fronts at half the lightness."""
     rgb = np.ones(labels.shape + (3,), np.float32)
-    hit = labels != EMPTY
-    rgb[hit] = colors[labels[hit]]
+    rgb[labels == FLOOR] = 0.85
+    full = np.concatenate([colors, colors * 0.5]) if len(colors) else colors
+    hit = labels >= 0
+    rgb[hit] = full[labels[hit]]
     return rgb
+
+
+def fitted_mpp(room: RoomInput, size: int, finest: float) -> float:
+    """m per pixel that fits the room's larger extent (and a 5% margin) into ``size`` pixels, never below ``finest``."""
+    return max(finest, float((room.outline.max(0) - room.outline.min(0)).max()) * 1.05 / size)
+
+
+def classifier_images(rooms: Sequence[RoomInput], index: dict[str, int], colors: np.ndarray, cfg: dict) -> np.ndarray:
+    """``(n, size, size, 3)`` classifier images of ``rooms``, each room fitted to the window (``cfg``: ``size``,
+    ``finest_mpp``, ``front``)."""
+    maps = [classifier_map(r, index, cfg["size"], fitted_mpp(r, cfg["size"], cfg["finest_mpp"]), cfg["front"])
+            for r in rooms]
+    labels = np.stack(maps) if maps else np.zeros((0, cfg["size"], cfg["size"]), np.int16)
+    return classifier_rgb(labels, colors)
 
 
 def dihedral(labels: np.ndarray) -> np.ndarray:

@@ -1,80 +1,100 @@
 """Real-vs-synthetic classification accuracy (SCA): a small CNN trained from scratch (no downloaded weights) to tell
-real top-down renders from generated ones. Train on real training renders vs half the generated ones, test on
-held-out real renders vs the other half, both balanced; re-initialised for each of ``runs`` runs. 50% is ideal;
-accuracies below 50% are folded to 100 - x (a classifier that is reliably wrong still tells the sets apart)."""
+real top-down renders from another set's. Two folds: the other set's rooms are split in halves by room (copies of
+one room stay together); the classifier trains on the real training renders against one half and is tested on the
+held-out real renders against the other, then the halves swap. Batches hold as many real as other renders, each
+batch turned and mirrored at random (a turned room is still a room). The score is the balanced accuracy over both
+folds' test predictions, folded to ``max(a, 100 - a)`` (a classifier that is reliably wrong still tells the sets
+apart), with a bootstrap 95% interval over the test renders. 50% is ideal."""
 from __future__ import annotations
 
 import numpy as np
 import torch
 from torch import nn
 
-from ..log import progress
 from ..learning.device import pick_device
 
 
-def classifier(width: int) -> nn.Module:
-    """Three conv-BN-ReLU-pool blocks, global average pooling and one logit."""
+def classifier(width: int, stride: int = 1) -> nn.Module:
+    """Three conv-BN-ReLU-pool blocks (the first conv with ``stride``), global average pooling and one logit."""
     layers, c = [], 3
     for k in range(3):
-        layers += [nn.Conv2d(c, width * 2 ** k, 3, padding=1), nn.BatchNorm2d(width * 2 ** k), nn.ReLU(), nn.MaxPool2d(2)]
+        layers += [nn.Conv2d(c, width * 2 ** k, 3, stride=stride if k == 0 else 1, padding=1),
+                   nn.BatchNorm2d(width * 2 ** k), nn.ReLU(), nn.MaxPool2d(2)]
         c = width * 2 ** k
     return nn.Sequential(*layers, nn.AdaptiveAvgPool2d(1), nn.Flatten(), nn.Linear(c, 1))
 
 
-def balanced(real: np.ndarray, fake: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """Images ``(2m, 3, s, s)`` and labels ``(2m,)`` (1: real) with ``m`` of each, ``m`` the smaller count."""
-    m = min(len(real), len(fake))
-    x = np.concatenate([real[rng.permutation(len(real))[:m]], fake[rng.permutation(len(fake))[:m]]])
-    return x, np.concatenate([np.ones(m), np.zeros(m)]).astype(np.float32)
+def _batch(x: torch.Tensor, size: int, gen: torch.Generator) -> torch.Tensor:
+    return x[torch.randint(len(x), (size,), generator=gen)]
 
 
-def fit_and_score(train: tuple[np.ndarray, np.ndarray], test: tuple[np.ndarray, np.ndarray], cfg: dict, seed: int,
-                  device: str) -> float:
-    """Accuracy on ``test`` of a freshly initialised classifier trained ``cfg['steps']`` Adam steps on ``train``."""
+def fit_and_predict(real: torch.Tensor, other: torch.Tensor, test: torch.Tensor, cfg: dict, seed: int) -> np.ndarray:
+    """``(t,)`` bool "real" predictions for ``test`` of a fresh classifier trained ``cfg['steps']`` Adam steps on
+    balanced, randomly turned and mirrored batches of ``real`` and ``other`` (``(n, 3, s, s)`` tensors)."""
     torch.manual_seed(seed)
-    net = classifier(cfg["width"]).to(device, memory_format=torch.channels_last)  # faster steps on a CPU
+    net = classifier(cfg["width"], cfg["stride"]).to(real.device, memory_format=torch.channels_last)  # faster steps on a CPU
     opt = torch.optim.Adam(net.parameters(), lr=cfg["lr"])
-    x = torch.as_tensor(train[0], device=device).to(memory_format=torch.channels_last)
-    y = torch.as_tensor(train[1], device=device)
     gen = torch.Generator().manual_seed(seed)
+    half = max(cfg["batch_size"] // 2, 1)
+    y = torch.cat([torch.ones(half), torch.zeros(half)]).to(real.device)
     net.train()
-    for _ in range(cfg["steps"]):  # steps, not epochs: a few dozen images still get a trained classifier
-        idx = torch.randint(len(x), (min(cfg["batch_size"], len(x)),), generator=gen)
-        loss = nn.functional.binary_cross_entropy_with_logits(net(x[idx]).squeeze(1), y[idx])
+    for _ in range(cfg["steps"]):
+        x = torch.cat([_batch(real, half, gen), _batch(other, half, gen)])
+        turn = int(torch.randint(8, (1,), generator=gen))
+        x = torch.rot90(x.flip(3) if turn >= 4 else x, turn % 4, (2, 3)).contiguous(memory_format=torch.channels_last)
+        loss = nn.functional.binary_cross_entropy_with_logits(net(x).squeeze(1), y)
         opt.zero_grad()
         loss.backward()
         opt.step()
     net.eval()
     with torch.no_grad():
-        xt = torch.as_tensor(test[0], device=device).to(memory_format=torch.channels_last)
-        pred = torch.cat([net(b).squeeze(1) > 0 for b in xt.split(256)]).cpu().numpy()
-    return float((pred == (test[1] > 0.5)).mean())
+        return torch.cat([net(b.contiguous(memory_format=torch.channels_last)).squeeze(1) > 0
+                          for b in test.split(256)]).cpu().numpy()
 
 
-def sca(real_train: np.ndarray, real_test: np.ndarray, generated: np.ndarray, cfg: dict, seed: int) -> dict:
-    """Mean and sd of the folded accuracy (%) over ``cfg['runs']`` runs. Images ``(n, s, s, 3)`` in [0, 1]; the
-    generated ones are split in two halves (train, test) anew per run."""
+def halves(groups: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Index arrays of two halves of the items, split by group (``groups (m,)``: one id per item)."""
+    ids = np.unique(groups)
+    first = set(rng.permutation(ids)[: len(ids) // 2].tolist())
+    mask = np.array([g in first for g in groups])
+    return np.flatnonzero(mask), np.flatnonzero(~mask)
+
+
+def balanced_accuracy(real_hits: np.ndarray, other_hits: np.ndarray) -> float:
+    """Mean of the shares of real and of other test renders classified right (%), folded to at least 50."""
+    acc = 50.0 * (real_hits.mean() + other_hits.mean())
+    return max(acc, 100.0 - acc)
+
+
+def sca(real_train: np.ndarray, real_test: np.ndarray, other: np.ndarray, groups: np.ndarray, cfg: dict,
+        seed: int) -> dict:
+    """The folded balanced accuracy (%) and its bootstrap 95% interval, the first fold's training renders and all
+    test predictions (real test renders are predicted once per fold). Images ``(n, s, s, 3)`` in [0, 1]."""
+    if min(len(real_train), len(real_test)) < 1 or len(np.unique(groups)) < 2:
+        return {"accuracy": float("nan"), "low": float("nan"), "high": float("nan"), "train": 0, "test": 0}
     device = pick_device(cfg["device"])
-    to_chw = lambda a: np.ascontiguousarray(np.asarray(a, np.float32).transpose(0, 3, 1, 2))
-    real_train, real_test, generated = to_chw(real_train), to_chw(real_test), to_chw(generated)
-    if min(len(real_train), len(real_test)) < 1 or len(generated) < 2:
-        return {"mean": float("nan"), "sd": float("nan"), "runs": [], "train": 0, "test": 0}
-    accs = []
-    for run in progress(range(cfg["runs"]), desc="SCA runs"):
-        rng = np.random.default_rng([seed, 5150, run])
-        perm = rng.permutation(len(generated))
-        half = len(generated) // 2
-        train = balanced(real_train, generated[perm[:half]], rng)
-        test = balanced(real_test, generated[perm[half:]], rng)
-        acc = fit_and_score(train, test, cfg, seed * 1000 + run, device)
-        accs.append(100.0 * max(acc, 1.0 - acc))
-    return {"mean": float(np.mean(accs)), "sd": float(np.std(accs)), "runs": accs, "train": len(train[1]),
-            "test": len(test[1])}
+    t = lambda a: torch.as_tensor(np.ascontiguousarray(np.asarray(a, np.float32).transpose(0, 3, 1, 2)), device=device)
+    real_train, real_test, other = t(real_train), t(real_test), t(other)
+    rng = np.random.default_rng([seed, 5150])
+    real_hits, other_hits = [], []
+    first, second = halves(groups, rng)
+    for fold, (fit, test) in enumerate(((first, second), (second, first))):
+        pred = fit_and_predict(real_train, other[fit], torch.cat([real_test, other[test]]), cfg, seed * 1000 + fold)
+        real_hits.append(pred[:len(real_test)])
+        other_hits.append(~pred[len(real_test):])
+    real_hits, other_hits = np.concatenate(real_hits), np.concatenate(other_hits)
+    boot = np.random.default_rng([seed, 5151])
+    reps = [balanced_accuracy(real_hits[boot.integers(len(real_hits), size=len(real_hits))],
+                              other_hits[boot.integers(len(other_hits), size=len(other_hits))])
+            for _ in range(cfg["bootstrap"])]
+    return {"accuracy": round(balanced_accuracy(real_hits, other_hits), 3),
+            "low": round(float(np.percentile(reps, 2.5)), 3), "high": round(float(np.percentile(reps, 97.5)), 3),
+            "train": len(real_train) + len(first), "test": len(real_hits) + len(other_hits)}
 
 
-def sca_scores(real_maps: tuple[np.ndarray, np.ndarray], generated: np.ndarray, cfg: dict, threads: int, seed: int) -> dict:
-    """:func:`sca` of one set's renders against the real training and held-out renders, rounded for the report."""
+def sca_scores(real_maps: tuple[np.ndarray, np.ndarray], sets: dict, cfg: dict, threads: int, seed: int) -> dict:
+    """:func:`sca` of each set ``name -> (images, groups)`` against the real training and held-out renders (groups
+    None: one per image)."""
     torch.set_num_threads(max(threads, 1))
-    out = sca(real_maps[0], real_maps[1], generated, cfg, seed)
-    return {k: (round(v, 3) if isinstance(v, float) else v) for k, v in out.items() if k != "runs"} | {
-        "runs": [round(a, 3) for a in out["runs"]]}
+    return {name: sca(real_maps[0], real_maps[1], images, np.arange(len(images)) if groups is None else groups, cfg,
+                      seed) for name, (images, groups) in sets.items()}

@@ -55,29 +55,10 @@ def rule_satisfaction(rs: RoomSet, checker) -> dict:
     return satisfaction([rule_view(checker.extract(r)) for r in progress(rs.rooms, desc=f"rules {rs.name}")])
 
 
-def set_summary(rows: pd.DataFrame, rs: RoomSet, real: RoomSet, eps: float) -> dict:
-    """Set-level figures of one set's scene rows against the held-out real rooms."""
-    objects = max(int(rows["objects"].sum()), 1)
-    mean = lambda col: None if rows[col].isna().all() else round(float(rows[col].mean()), 5)
-    return {
-        "scenes": len(rows), "attempted": rs.attempted,
-        "partial": 0 if rs.scenes is None else int((rs.scenes["status"].astype(str) == "partial").sum()),
-        "category_kl": round(distributions.category_kl(_categories(real), _categories(rs), eps), 6),
-        "count_distance": round(distributions.count_distance([len(r.object_ids) for r in real.rooms],
-                                                             [len(r.object_ids) for r in rs.rooms]), 5),
-        "object_collision_rate": round(float(rows["colliding_objects"].sum() / objects), 5),
-        "scene_collision_rate": round(float((rows["colliding_objects"] > 0).mean()), 5) if len(rows) else None,
-        "out_of_bounds_rate": round(float(rows["out_of_bounds"].sum() / objects), 5),
-        "walkable_share": mean("walkable_share"),
-        "reachable_scenes": round(float((rows["reachable"] >= 1.0).mean()), 5) if len(rows) else None,
-        "consistency": mean("consistency"), "violation": mean("violation"),
-        "nn_similarity": {"mean": mean("nn_similarity"),
-                          "sd": None if len(rows) < 2 else round(float(rows["nn_similarity"].std(ddof=0)), 5)},
-    }
-
-
-def _categories(rs: RoomSet) -> list[str]:
-    return distributions.flatten([r.categories for r in rs.rooms])
+def set_counts(rows: pd.DataFrame, rs: RoomSet) -> dict:
+    """How many rooms a set scores, how many its method attempted and how many of them are partial."""
+    return {"scenes": len(rows), "attempted": rs.attempted,
+            "partial": 0 if rs.scenes is None else int((rs.scenes["status"].astype(str) == "partial").sum())}
 
 
 def floors(train: RoomSet, real: RoomSet, generated: int, cfg: dict, seed: int) -> dict:
@@ -105,19 +86,26 @@ def train_similarity(train_maps: np.ndarray, sample: int, seed: int) -> dict:
     return {"mean": round(float(np.mean(best)), 5), "sd": round(float(np.std(best)), 5), "rooms": len(pick)}
 
 
-def goals(sets: dict, fl: dict, first: str, real: str) -> dict:
-    """The evaluation issue's goals for the first method's rooms (reported, never tuned against)."""
+def goals(metrics: dict, first: str, real: str) -> dict:
+    """The evaluation issue's goals for the first method's rooms and for the evaluation itself (reported, never tuned
+    against). The classifier's goal reads ``inconclusive`` when its power check failed."""
+    sets, fl, checks = metrics["sets"], metrics["floors"], metrics["checks"]
     g, r = sets[first], sets[real]
     within = lambda key: (fl[key]["mean"] == fl[key]["mean"] and g[key] <= 1.5 * max(fl[key]["mean"], 1e-9))
+    near = lambda key, points: (g[key] == g[key] and r[key] == r[key] and abs(g[key] - r[key]) <= points)
     out = {"category_kl_within_1.5x_floor": within("category_kl"),
            "count_distance_within_1.5x_floor": within("count_distance"),
            "collision_rate_at_most_real": g["object_collision_rate"] <= r["object_collision_rate"],
            "out_of_bounds_rate_at_most_real": g["out_of_bounds_rate"] <= r["out_of_bounds_rate"],
-           "walkable_within_5_points_of_real": (g["walkable_share"] is not None and r["walkable_share"] is not None
-                                                and abs(g["walkable_share"] - r["walkable_share"]) <= 0.05)}
-    if g.get("sca") and g["sca"]["mean"] == g["sca"]["mean"]:
-        out["sca_at_most_60"] = g["sca"]["mean"] <= 60.0
-    return {k: bool(v) for k, v in out.items()}
+           "walkable_within_5_points_of_real": near("walkable_share", 0.05),
+           "functional_all_within_5_points_of_real": near("functional_all", 0.05),
+           "real_rooms_pass_every_functional_check_95": all(not r[c] == r[c] or r[c] >= 0.95 for c in checks),
+           "classifier_power_check_passed": metrics["power"]["passed"]}
+    out = {k: bool(v) for k, v in out.items()}
+    sca = (g.get("sca") or {}).get("accuracy")
+    if sca is not None and sca == sca:
+        out["sca_at_most_60"] = bool(sca <= 60.0) if metrics["power"]["passed"] else "inconclusive"
+    return out
 
 
 def finite(value):
@@ -139,19 +127,21 @@ def label_maps(rs: RoomSet, index: dict, cfg: dict) -> np.ndarray:
 
 
 TABLE_COLUMNS = ["scenes", "attempted", "category_kl", "count_distance", "object_collision_rate", "scene_collision_rate",
-                 "out_of_bounds_rate", "walkable_share", "reachable_scenes", "consistency", "violation"]
+                 "out_of_bounds_rate", "walkable_share", "reachable_scenes", "consistency", "violation", "nn_similarity",
+                 "contents_excess", "contents_missing", "functional_all"]
 
 
 def metrics_table(metrics: dict) -> pd.DataFrame:
-    """One row per set (the sampling floors and the training rooms' own similarity as rows of their own)."""
-    rows = [{"set": name, **{k: s[k] for k in TABLE_COLUMNS}, "nn_similarity": s["nn_similarity"]["mean"],
-             "sca_mean": (s.get("sca") or {}).get("mean"), "sca_sd": (s.get("sca") or {}).get("sd")}
-            for name, s in metrics["sets"].items()]
+    """One row per set with every figure and the classifier's accuracy (the sampling floors and the training
+    rooms' own similarity as rows of their own), then one row per power set."""
+    rows = [{"set": name, **{k: s.get(k) for k in TABLE_COLUMNS + metrics["checks"]},
+             "sca": (s.get("sca") or {}).get("accuracy")} for name, s in metrics["sets"].items()]
     fl = metrics["floors"]
     rows.append({"set": "floor (real vs real)", "category_kl": fl["category_kl"]["mean"],
                  "count_distance": fl["count_distance"]["mean"]})
     rows.append({"set": "training vs nearest training", "nn_similarity": metrics["train_nn_similarity"]["mean"]})
-    frame = pd.DataFrame(rows, columns=["set", *TABLE_COLUMNS, "nn_similarity", "sca_mean", "sca_sd"])
+    rows += [{"set": f"power: {name}", "sca": s["accuracy"]} for name, s in metrics["power"]["scores"].items()]
+    frame = pd.DataFrame(rows, columns=["set", *TABLE_COLUMNS, *metrics["checks"], "sca"])
     return frame.astype({"scenes": "Int64", "attempted": "Int64"})
 
 

@@ -13,6 +13,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from .. import duck, tables
+from ..html import write_table_html
 
 ARCH = "('wall_adjacent', 'wall_opposite', 'opening')"
 
@@ -79,9 +80,16 @@ def print_report(report: dict[str, pd.DataFrame], stream: TextIO) -> None:
         console.print(t)
 
 
+HTML = {"table1": ("Table 1: relation graphs per room type", "Rooms, and per room the average nodes and edges "
+                   "(kept; non_wall: between objects), edges per node before and after pruning, hubs and chains."),
+        "pruning": ("Pruning by rule", "Raw object edges per room type and the refinement rule that kept or pruned "
+                    "each; share_of_raw: their share of the room type's raw object edges.")}
+
+
 def write_report(report: dict[str, pd.DataFrame], outputs: dict[str, Path]) -> list[Path]:
-    """CSV per table (``outputs[name]``) and one PNG (``outputs['plot']``): edges per node before/after pruning and
-    the pruning shares, per room type. Every file is written atomically."""
+    """CSV per table (``outputs[name]``), an HTML page per table of ``HTML`` (``outputs[name + '_html']``, where
+    given) and one PNG (``outputs['plot']``): edges per node before/after pruning and the pruning shares, per room
+    type. Every file is written atomically."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -89,6 +97,10 @@ def write_report(report: dict[str, pd.DataFrame], outputs: dict[str, Path]) -> l
 
     for name, df in report.items():
         tables.write_csv(outputs[name], df)
+        if outputs.get(f"{name}_html") is not None:
+            title, caption = HTML[name]
+            write_table_html(outputs[f"{name}_html"], df, title, f"{caption} The same rows are in "
+                                                                 f"{Path(outputs[name]).name}.")
     t1, pr = report["table1"], report["pruning"]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
     x = range(len(t1))
@@ -106,7 +118,7 @@ def write_report(report: dict[str, pd.DataFrame], outputs: dict[str, Path]) -> l
     ax2.legend(fontsize=7, bbox_to_anchor=(1.0, 1.0), loc="upper left")
     fig.tight_layout()
     tables.write_figure(outputs["plot"], fig, dpi=110)
-    return [Path(outputs[k]) for k in (*report, "plot")]
+    return [Path(outputs[k]) for k in (*report, "plot", *(f"{n}_html" for n in HTML)) if outputs.get(k) is not None]
 
 
 def print_room(graph_dir: Path, room_id: str, stream: TextIO) -> None:

@@ -7,9 +7,11 @@ from pathlib import Path
 from .. import tables
 from ..evaluation.evaluate import evaluate_room_type
 from ..evaluation.gallery import gallery
+from ..evaluation.pages import evaluation_page, power_figure
 from ..evaluation.scores import metrics_table
 from ..evaluation.sets import generated_sets, load_real
 from ..graphs.files import read_split
+from ..html import write_html
 from ..stage import Files
 
 
@@ -24,6 +26,8 @@ def run(config: dict, inp: Files, out: Files, room_type: str, threads: int = 1) 
                                         {r["model_id"]: r["symmetry"] for r in sym}, threads)
     tables.write(out.scenes, "eval_scenes", tables.from_rows("eval_scenes", tables.records(frame)))
     tables.write_csv(out.table, metrics_table(metrics))
+    write_html(out.table_html, evaluation_page(metrics))
+    tables.write_figure(out.power, power_figure(metrics), dpi=110)
     gallery(out.gallery, gen[0], Path(inp.generated_files[0]), real, inp.nodes, inp.edges, config["evaluate"]["gallery"])
     tables.write_json(out.metrics, metrics)
     return {name: s["category_kl"] for name, s in metrics["sets"].items()}

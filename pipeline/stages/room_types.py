@@ -9,6 +9,7 @@ import pandas as pd
 
 from .. import tables
 from ..config import candidate_room_types
+from ..html import write_table_html
 from ..stage import Files
 
 log = logging.getLogger("planit.room_types")
@@ -29,4 +30,7 @@ def run(config: dict, inp: Files, out: Files) -> pd.DataFrame:
                          "reason": reason or ""})
     frame = pd.DataFrame(out_rows, columns=["room_type", "graphs", "status", "reason"])
     tables.write_csv(out.table, frame)
+    write_table_html(out.table_html, frame, "Room types learned and skipped",
+                     f"Every candidate room type with its final graphs; one with fewer than {MIN_GRAPHS} is skipped "
+                     f"with its reason. The same rows are in {out.table.name}.")
     return frame

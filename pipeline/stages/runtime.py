@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from .. import tables
+from ..html import write_table_html
 from ..stage import Files
 
 log = logging.getLogger("planit.runtime")
@@ -51,6 +52,9 @@ def run(config: dict, inp: Files, outputs: Files, benchmarks: str) -> pd.DataFra
     benchmarks = Path(benchmarks)
     table = per_rule(read_benchmarks(benchmarks))
     tables.write_csv(out, table)
+    write_table_html(outputs.table_html, table, "Run time per rule",
+                     f"The wall-clock span, all job seconds, then per rule (slowest first). The same rows are in "
+                     f"{out.name}.", notes={"share": "share of all job seconds"})
     for row in table.head(8).itertuples(index=False):
         log.info("  %-48s %4d jobs %8.1f s", row.rule, row.jobs, row.job_seconds)
     return table

@@ -1,0 +1,165 @@
+"""Functional checks learned from the training split and scored on any room by the same code: does every target
+of a category stand where the training rooms put it around an anchor of another category (region, gap, facing;
+``geometry/function.py``), does every object of a wall category stand with its back to a wall, and are the contents
+plausible (no category more often than in any training room, no category missing that (nearly) every training room
+holds). A check is kept only where the training rooms show it with confidence: the Wilson 95% lower bound of its
+share of training rooms is at least ``min_share``."""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import asdict, dataclass
+from itertools import product
+
+import numpy as np
+
+from ..geometry.function import REGIONS, back_to_wall, facing_angles, plan_gaps, regions
+from ..room import RoomInput
+
+REGION_SETS = {"any": None, "side": ("side_front", "side_back"), **{r: (r,) for r in REGIONS if r != "corner"}}
+FACINGS = ("any", "faces", "away")
+ROOM_COLUMNS = ("contents_excess", "contents_missing", "functional_all")  # per room, in the eval_scenes table
+
+
+@dataclass(frozen=True)
+class Predicate:
+    """Where a target stands around an anchor: a region name of :data:`REGION_SETS`, a gap (m, None: any) and a
+    facing of :data:`FACINGS`."""
+    region: str
+    gap: float | None
+    facing: str
+
+    def specificity(self) -> int:
+        return ((self.region != "any") + (self.region not in ("any", "side"))
+                + (self.gap is not None) + (self.facing != "any"))
+
+    def implies(self, other: "Predicate") -> bool:
+        within = REGION_SETS[other.region] is None or set(REGION_SETS[self.region] or REGIONS) <= set(
+            REGION_SETS[other.region])
+        return within and (other.gap is None or (self.gap is not None and self.gap <= other.gap)) and (
+            other.facing in ("any", self.facing))
+
+
+def vocabulary(cfg: dict) -> list[Predicate]:
+    """Every predicate but the empty one (any region, any gap, any facing)."""
+    return [Predicate(r, g, f) for r, g, f in product(REGION_SETS, [None, *sorted(cfg["gaps"])], FACINGS)
+            if (r, g, f) != ("any", None, "any")]
+
+
+def predicate_masks(room: RoomInput, preds: list[Predicate], cfg: dict) -> np.ndarray:
+    """``(p, n, n)`` bool: predicate ``p`` holds for target ``j`` around anchor ``i`` (never ``i == j``)."""
+    n = len(room.object_ids)
+    region, gap, angle = regions(room.boxes), plan_gaps(room.boxes), facing_angles(room.boxes)
+    lim = np.radians(cfg["facing_angle"])
+    facing = {"any": np.ones((n, n), bool), "faces": angle <= lim, "away": angle >= np.pi - lim}
+    out = np.empty((len(preds), n, n), bool)
+    for k, p in enumerate(preds):
+        where = np.ones((n, n), bool) if REGION_SETS[p.region] is None else np.isin(
+            region, [REGIONS.index(r) for r in REGION_SETS[p.region]])
+        out[k] = where & (gap <= (np.inf if p.gap is None else p.gap)) & facing[p.facing]
+    out[:, np.arange(n), np.arange(n)] = False
+    return out
+
+
+def pair_outcomes(room: RoomInput, masks: np.ndarray, anchor: str, target: str) -> np.ndarray | None:
+    """``(p,)`` bool: every ``target`` of the room has an ``anchor`` for which the predicate holds (None: the room
+    lacks one of the two categories)."""
+    cats = np.asarray(room.categories)
+    a, t = np.flatnonzero(cats == anchor), np.flatnonzero(cats == target)
+    if not len(a) or not len(t) or (anchor == target and len(t) < 2):
+        return None
+    return masks[:, a][:, :, t].any(axis=1).all(axis=1)
+
+
+def wilson_lower(passed: int, total: int, z: float = 1.96) -> float:
+    """The Wilson score interval's lower bound of a share ``passed / total`` (0 for no trials)."""
+    if total == 0:
+        return 0.0
+    p = passed / total
+    centre = p + z * z / (2 * total)
+    return float((centre - z * np.sqrt(p * (1 - p) / total + z * z / (4 * total * total))) / (1 + z * z / total))
+
+
+def learn_pair_checks(rooms: list[RoomInput], cfg: dict) -> list[dict]:
+    """The confident (anchor, target, predicate) checks of the training rooms: per category pair the most specific
+    confident predicate (ties: the higher training share), the pairs held by the most rooms first."""
+    preds = vocabulary(cfg)
+    tally: dict[tuple[str, str], list] = {}
+    for room in rooms:
+        masks = predicate_masks(room, preds, cfg)
+        for a, t in product(sorted(set(room.categories)), repeat=2):
+            outcome = pair_outcomes(room, masks, a, t)
+            if outcome is not None:
+                tally.setdefault((a, t), []).append(outcome)
+    checks = []
+    for (a, t), outcomes in tally.items():
+        passed, total = np.sum(outcomes, axis=0), len(outcomes)
+        if total < cfg["min_rooms"]:
+            continue
+        ok = [k for k in range(len(preds)) if wilson_lower(int(passed[k]), total) >= cfg["min_share"]]
+        best = [k for k in ok if not any(preds[m] != preds[k] and preds[m].implies(preds[k]) for m in ok)]
+        if best:
+            k = max(best, key=lambda k: (preds[k].specificity(), passed[k], -k))
+            checks.append({"kind": "pair", "anchor": a, "target": t, **asdict(preds[k]), "train_rooms": total,
+                           "train_share": round(float(passed[k] / total), 4)})
+    checks.sort(key=lambda c: (-c["train_rooms"], c["anchor"], c["target"]))
+    return checks[:cfg["max_checks"]]
+
+
+def wall_outcome(room: RoomInput, category: str, cfg: dict) -> bool | None:
+    """Every object of ``category`` stands with its back to a wall (None: the room has none)."""
+    k = [i for i, c in enumerate(room.categories) if c == category]
+    if not k:
+        return None
+    return bool(back_to_wall(room.boxes[k], room.outline, cfg["wall"]["max_gap"],
+                             np.radians(cfg["wall"]["max_angle"])).all())
+
+
+def learn_wall_checks(rooms: list[RoomInput], cfg: dict) -> list[dict]:
+    """The categories whose objects the training rooms confidently stand with their backs to a wall."""
+    out = []
+    for cat in sorted({c for r in rooms for c in r.categories}):
+        seen = [o for o in (wall_outcome(r, cat, cfg) for r in rooms) if o is not None]
+        if len(seen) >= cfg["min_rooms"] and wilson_lower(sum(seen), len(seen)) >= cfg["min_share"]:
+            out.append({"kind": "wall", "target": cat, "train_rooms": len(seen),
+                        "train_share": round(sum(seen) / len(seen), 4)})
+    return out
+
+
+def learn_contents(rooms: list[RoomInput], cfg: dict) -> dict:
+    """Each category's largest count in one training room, and the categories (nearly) every training room holds."""
+    counts = [Counter(r.categories) for r in rooms]
+    cats = sorted({c for r in rooms for c in r.categories})
+    required = [c for c in cats if wilson_lower(sum(c in k for k in counts), len(rooms)) >= cfg["min_share"]]
+    return {"max_count": {c: max(k[c] for k in counts) for c in cats}, "required": required}
+
+
+def learn_checks(rooms: list[RoomInput], cfg: dict) -> dict:
+    """Everything the functional checks learn from the training rooms (JSON-ready)."""
+    return {"checks": learn_pair_checks(rooms, cfg) + learn_wall_checks(rooms, cfg),
+            "contents": learn_contents(rooms, cfg), "training_rooms": len(rooms)}
+
+
+def check_name(check: dict) -> str:
+    """A short column name: ``fn:<target>@<anchor>`` or ``fn:<target>@wall``."""
+    return f"fn:{check['target']}@{check.get('anchor', 'wall')}"
+
+
+def score_room(room: RoomInput, learned: dict, cfg: dict) -> dict:
+    """One room's outcome per check (1.0 pass, 0.0 fail, NaN where the room lacks its categories), its contents
+    (``contents_excess``, ``contents_missing``) and ``functional_all`` (1.0: every applicable check passes)."""
+    row, preds = {}, {}
+    pair = [c for c in learned["checks"] if c["kind"] == "pair"]
+    preds = [Predicate(c["region"], c["gap"], c["facing"]) for c in pair]
+    masks = predicate_masks(room, preds, cfg) if pair else None
+    for k, c in enumerate(pair):
+        o = pair_outcomes(room, masks[k:k + 1], c["anchor"], c["target"])
+        row[check_name(c)] = np.nan if o is None else float(o[0])
+    for c in (c for c in learned["checks"] if c["kind"] == "wall"):
+        o = wall_outcome(room, c["target"], cfg)
+        row[check_name(c)] = np.nan if o is None else float(o)
+    outcomes = [v for v in row.values() if v == v]
+    counts, cont = Counter(room.categories), learned["contents"]
+    row["contents_excess"] = float(any(n > cont["max_count"].get(c, 0) for c, n in counts.items()))
+    row["contents_missing"] = float(any(c not in counts for c in cont["required"]))
+    row["functional_all"] = float(all(v == 1.0 for v in outcomes) and row["contents_excess"] == 0.0 and row["contents_missing"] == 0.0)
+    return row

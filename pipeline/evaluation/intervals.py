@@ -1,0 +1,89 @@
+"""Set figures from per-room rows, with bootstrap 95% intervals: every set's rooms (and the held-out real rooms they
+are compared with) resampled with replacement together, the figures recomputed per replicate; the difference of
+every set from a reference set (PlanIT, the real rooms) taken per replicate, so its interval says whether the
+difference is more than the noise of the sample sizes. Pure NumPy and pandas."""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pandas as pd
+
+from .distributions import count_distance
+
+CATEGORY = "cat:"  # prefix of the per-room category count columns
+
+
+def category_kl_counts(real: np.ndarray, generated: np.ndarray, eps: float) -> float:
+    """ATISS's category KL from two category count vectors ``(c,)`` over the same categories (only those of either
+    set count), as :func:`distributions.category_kl`."""
+    keep = (real > 0) | (generated > 0)
+    if not keep.any():
+        return 0.0
+    p, q = real[keep] / max(real.sum(), 1), generated[keep] / max(generated.sum(), 1)
+    return float(np.sum(p * (np.log(p + eps) - np.log(q + eps))))
+
+
+def _mean(frame: pd.DataFrame, column: str) -> float:
+    values = frame[column].to_numpy(float) if column in frame else np.zeros(0)
+    values = values[np.isfinite(values)]
+    return float(values.mean()) if len(values) else float("nan")
+
+
+def figures(rows: pd.DataFrame, real: pd.DataFrame, eps: float, extra: list[str]) -> dict[str, float]:
+    """The set figures of one set's per-room ``rows`` against the real rooms' ``real`` rows: the distribution
+    distances, collision, bounds and walkability rates, and the mean of every ``extra`` column (NaN ignored)."""
+    cats = [c for c in rows.columns if c.startswith(CATEGORY)]
+    objects = max(float(rows["objects"].sum()), 1.0)
+    scenes = len(rows)
+    out = {
+        "category_kl": category_kl_counts(real[cats].to_numpy(float).sum(0), rows[cats].to_numpy(float).sum(0), eps),
+        "count_distance": count_distance(real["objects"].tolist(), rows["objects"].tolist()),
+        "object_collision_rate": float(rows["colliding_objects"].sum()) / objects,
+        "scene_collision_rate": float((rows["colliding_objects"] > 0).mean()) if scenes else float("nan"),
+        "out_of_bounds_rate": float(rows["out_of_bounds"].sum()) / objects,
+        "walkable_share": _mean(rows, "walkable_share"),
+        "reachable_scenes": float((rows["reachable"] >= 1.0).mean()) if scenes else float("nan"),
+    }
+    return out | {c: _mean(rows, c) for c in extra}
+
+
+def bootstrap(sets: dict[str, pd.DataFrame], real: str, stat: Callable[[pd.DataFrame, pd.DataFrame], dict],
+              repeats: int, seed: int) -> dict[str, pd.DataFrame]:
+    """``repeats`` replicates of ``stat(rows, real_rows)`` per set (a frame per set: one row per replicate, one
+    column per figure), every set and the real rooms resampled independently in each replicate."""
+    rng = np.random.default_rng([seed, 8080])
+    reps: dict[str, list[dict]] = {name: [] for name in sets}
+    for _ in range(repeats):
+        pick = {n: f.iloc[rng.integers(len(f), size=len(f))] if len(f) else f for n, f in sets.items()}
+        for name in sets:
+            reps[name].append(stat(pick[name], pick[real]))
+    return {name: pd.DataFrame(r) for name, r in reps.items()}
+
+
+def interval(values: pd.Series) -> tuple[float, float]:
+    """The 2.5th and 97.5th percentiles of the finite values (NaN, NaN if none)."""
+    v = values.to_numpy(float)
+    v = v[np.isfinite(v)]
+    return (float(np.percentile(v, 2.5)), float(np.percentile(v, 97.5))) if len(v) else (float("nan"), float("nan"))
+
+
+def intervals(reps: dict[str, pd.DataFrame]) -> dict[str, dict[str, list[float]]]:
+    """``set -> figure -> [low, high]``."""
+    return {name: {col: list(interval(frame[col])) for col in frame.columns} for name, frame in reps.items()}
+
+
+def differences(reps: dict[str, pd.DataFrame], reference: str, sizes: dict[str, int],
+                min_rooms: int) -> dict[str, dict[str, dict]]:
+    """``set -> figure -> {low, high, excludes_zero}``: each set's replicate figures minus the reference set's;
+    ``excludes_zero`` only where both sets hold at least ``min_rooms`` rooms (``sizes``: rooms per set), since a
+    handful of rooms resamples to a degenerate interval."""
+    out = {}
+    for name, frame in reps.items():
+        if name == reference:
+            continue
+        diff = frame - reps[reference]
+        enough = min(sizes[name], sizes[reference]) >= min_rooms
+        out[name] = {col: (lambda lo, hi: {"low": lo, "high": hi, "excludes_zero": bool(enough and (lo > 0 or hi < 0))})(
+            *interval(diff[col])) for col in frame.columns}
+    return out

@@ -1,0 +1,44 @@
+"""The classifier's power check: before the real-vs-synthetic classifier scores any method, the same protocol scores
+known-bad sets made from the held-out real rooms (``perturb.py``) and a real-vs-real control (training rooms held
+back from the classifier's real class and scored as the other set). The check passes when every required
+perturbation is detected with at least ``min_accuracy`` and the control stays within ``null_tolerance`` of 50%;
+a method's SCA is only read against its goal when it passes (otherwise: inconclusive)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..room import RoomInput
+from .perturb import perturbed
+
+CONTROL = "real_vs_real"
+
+
+def perturbation_name(spec: dict) -> str:
+    """``jitter_0.1``, ``turns``, ...: a power set's name."""
+    return f"{spec['kind']}_{spec['strength']:g}" if spec["kind"] == "jitter" else spec["kind"]
+
+
+def power_sets(real: list[RoomInput], cfg: dict, seed: int) -> dict[str, tuple[list[RoomInput], np.ndarray]]:
+    """``name -> (rooms, groups)``: ``cfg['copies']`` perturbed copies of every held-out real room per perturbation
+    of ``cfg['perturbations']`` (a room's copies share a group, so they land in the same fold)."""
+    groups = np.repeat(np.arange(len(real)), cfg["copies"])
+    return {perturbation_name(p): (perturbed(real, p["kind"], p.get("strength", 0.0), cfg["copies"], seed), groups)
+            for p in cfg["perturbations"]}
+
+
+def control_split(train: list[RoomInput], size: int, seed: int) -> tuple[list[RoomInput], list[RoomInput]]:
+    """The training rooms split into the classifier's real class and ``size`` held-back real rooms (at most half)."""
+    perm = np.random.default_rng([seed, 4242]).permutation(len(train))
+    back = min(size, len(train) // 2)
+    return [train[k] for k in perm[back:]], [train[k] for k in perm[:back]]
+
+
+def verdict(scores: dict[str, dict], cfg: dict) -> dict:
+    """Whether the power check passes: each required perturbation's accuracy and the control's distance from 50%."""
+    required = {perturbation_name(p) for p in cfg["perturbations"] if p.get("required")}
+    misses = [n for n in sorted(required) if not scores[n]["accuracy"] >= cfg["min_accuracy"]]
+    control = scores[CONTROL]["accuracy"]
+    null_ok = bool(abs(control - 50.0) <= cfg["null_tolerance"])
+    return {"passed": bool(not misses and null_ok), "required": sorted(required), "missed": misses,
+            "control_within_tolerance": null_ok, "min_accuracy": cfg["min_accuracy"],
+            "null_tolerance": cfg["null_tolerance"]}

@@ -1,0 +1,81 @@
+"""Functional relations between objects, from their oriented boxes: where a target stands around an anchor (its
+region in the anchor's frame), how far (the plan gap between footprints), whether it faces the anchor, and whether
+an object stands with its back to a wall. Pure functions over ``(n, 7)`` boxes (``cx, cy, cz, hx, hy, hz, yaw``;
+local +y is the front); one implementation for the evaluation's functional checks and every method that wants them.
+
+Regions of a target's centre in an anchor's frame, its footprint scaled to the unit square ``|u|, |v| <= 1``:
+``front`` (v > 1, |u| <= 1), ``back`` (v < -1), ``side_front`` / ``side_back`` (|u| > 1, |v| <= 1, the front or
+back half: a nightstand beside a bed's head is ``side_back``), ``corner`` (|u| > 1 and |v| > 1) and ``over``
+(inside the footprint: on it, under it or tucked in).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .boxes import footprint_corners, footprint_overlap, rotation
+from .polygon import inward_normals, make_ccw, polygon_segments
+
+REGIONS = ("front", "back", "side_front", "side_back", "corner", "over")
+
+
+def regions(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n)`` index into :data:`REGIONS` of target ``j``'s centre in anchor ``i``'s frame (row: anchor)."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    rel = b[None, :, :2] - b[:, None, :2]  # (anchor, target, 2)
+    local = np.einsum("aji,atj->ati", rotation(b[:, 6]), rel)  # R^T (world -> anchor's local)
+    u = np.abs(local[..., 0]) / np.maximum(b[:, None, 3], 1e-9)
+    v = local[..., 1] / np.maximum(b[:, None, 4], 1e-9)
+    wide, long = u > 1.0, np.abs(v) > 1.0
+    out = np.where(wide & long, 4, np.where(wide, np.where(v >= 0, 2, 3), np.where(long, np.where(v > 0, 0, 1), 5)))
+    return out.astype(np.int8)
+
+
+def plan_gaps(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n)`` symmetric distance (m) between the footprints of every pair (0 where they overlap)."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    n = len(b)
+    corners = footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])  # (n, 4, 2)
+    edges = np.stack([corners, np.roll(corners, -1, axis=1)], 2)  # (n, 4, 2, 2)
+    a, d = edges[:, :, 0], edges[:, :, 1] - edges[:, :, 0]  # (n, 4, 2)
+    p = corners[:, None, :, None, :] - a[None, :, None, :, :]  # (point box, edge box, corner, edge, 2)
+    t = np.clip(np.einsum("pqcej,qej->pqce", p, d) / np.maximum(np.einsum("qej,qej->qe", d, d), 1e-18)[None, :, None],
+                0.0, 1.0)
+    dist = np.linalg.norm(p - t[..., None] * d[None, :, None], axis=-1).min((2, 3))  # corner of p to edges of q
+    gap = np.minimum(dist, dist.T)
+    i, j = np.triu_indices(n, 1)
+    touching = footprint_overlap(corners[i], b[i, 6], corners[j], b[j, 6]) > 0
+    gap[i[touching], j[touching]] = gap[j[touching], i[touching]] = 0.0
+    np.fill_diagonal(gap, 0.0)
+    return gap
+
+
+def facing_angles(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n)`` angle (rad, 0..pi) between target ``j``'s front and the direction from its centre to anchor
+    ``i``'s footprint (its nearest point; its centre where ``j``'s centre lies inside it). Row: anchor."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    local = np.einsum("aji,atj->ati", rotation(b[:, 6]), b[None, :, :2] - b[:, None, :2])  # target in anchor frame
+    half = b[:, None, 3:5]
+    near = np.clip(local, -half, half)  # nearest footprint point, anchor frame
+    inside = np.all(np.abs(local) <= half, axis=-1)
+    near = np.where(inside[..., None], 0.0, near)
+    to_anchor = np.einsum("aij,atj->ati", rotation(b[:, 6]), near - local)  # world direction target -> anchor
+    front = np.stack([-np.sin(b[:, 6]), np.cos(b[:, 6])], -1)[None]  # (1, target, 2)
+    cos = np.einsum("atj,atj->at", to_anchor, front) / np.maximum(np.linalg.norm(to_anchor, axis=-1), 1e-12)
+    return np.arccos(np.clip(cos, -1.0, 1.0))
+
+
+def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_angle: float) -> np.ndarray:
+    """``(n,)`` bool: the object's back faces a wall of the floor ``outline (k, 2)`` (its back normal within
+    ``max_angle`` rad of the wall's outward normal) and its back side's midpoint lies within ``max_gap`` m of that
+    wall's inner face, over the wall's length."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    walls = polygon_segments(make_ccw(np.asarray(outline, float)))
+    normal = inward_normals(walls)  # (w, 2) into the room
+    back = -np.stack([-np.sin(b[:, 6]), np.cos(b[:, 6])], -1)  # (n, 2)
+    mid = b[:, :2] + back * b[:, 4:5]  # back side's midpoint
+    rel = mid[:, None] - walls[None, :, 0]  # (n, w, 2)
+    d = walls[:, 1] - walls[:, 0]
+    along = np.einsum("nwj,wj->nw", rel, d) / np.maximum(np.einsum("wj,wj->w", d, d), 1e-18)
+    off = np.einsum("nwj,wj->nw", rel, normal)  # distance in front of the wall's face
+    aligned = back @ (-normal).T >= np.cos(max_angle)
+    return np.any(aligned & (np.abs(off) <= max_gap) & (along >= 0.0) & (along <= 1.0), axis=1)

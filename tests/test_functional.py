@@ -1,0 +1,126 @@
+"""Functional checks learned from hand-built training rooms and scored on hand-built test rooms with known answers
+(a nightstand at the foot of the bed fails, one at its head passes; a chair facing away from its desk fails); the
+known-bad perturbations of the classifier's power check; bootstrap intervals that see a real difference and no
+false one."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from conftest import Room, default_config
+from pipeline.evaluation import functional, intervals, perturb, power
+from pipeline.geometry.function import back_to_wall, facing_angles, plan_gaps, regions, REGIONS
+
+SQUARE = [(0, 0), (4, 0), (4, 4), (0, 4)]
+
+
+def bedroom(dx=0.0, nightstand_y=3.8, chair_yaw=180.0, beds=1, nightstands=2, room_id="r0"):
+    """A bed with its head against the top wall between two nightstands, a desk against the bottom wall with its
+    chair facing it; ``dx`` shifts everything along the walls."""
+    room = Room(SQUARE, room_id=room_id)
+    for k in range(beds):
+        room.add(f"bed{k}", "bed", (1.6, 2.0, 0.5), (2.0 + dx - 1.7 * k, 3.0), 180)
+    for k, x in enumerate((0.975, 3.025)[:nightstands]):
+        room.add(f"ns{k}", "nightstand", (0.45, 0.4, 0.55), (x + dx, nightstand_y), 180)
+    room.add("desk", "desk", (1.2, 0.6, 0.75), (2.0 + dx, 0.3), 0)
+    room.add("chair", "chair", (0.5, 0.5, 0.9), (2.0 + dx, 0.85), chair_yaw)
+    return room.room_input()
+
+
+@pytest.fixture(scope="module")
+def learned():
+    cfg = {**default_config()["evaluate"]["functional"], "min_share": 0.85}  # 25 rooms: Wilson bound 0.87 at best
+    train = [bedroom(dx, room_id=f"t{k}") for k, dx in enumerate(np.linspace(-0.6, 0.6, 25))]
+    return functional.learn_checks(train, cfg), cfg
+
+
+def test_the_predicates_place_a_nightstand_at_the_head_and_a_chair_facing_its_desk():
+    room = bedroom()
+    cats = room.categories
+    bed, ns, desk, chair = (cats.index(c) for c in ("bed", "nightstand", "desk", "chair"))
+    assert REGIONS[regions(room.boxes)[bed, ns]] == "side_back"
+    assert REGIONS[regions(bedroom(nightstand_y=2.2).boxes)[bed, ns]] == "side_front"  # at the foot
+    assert plan_gaps(room.boxes)[bed, ns] == pytest.approx(0.0, abs=1e-9)  # flush
+    assert plan_gaps(room.boxes)[desk, chair] == pytest.approx(0.0, abs=1e-9)  # tucked in: touching
+    assert np.degrees(facing_angles(room.boxes)[desk, chair]) == pytest.approx(0.0, abs=1e-6)
+    assert np.degrees(facing_angles(bedroom(chair_yaw=0.0).boxes)[desk, chair]) == pytest.approx(180.0, abs=1e-6)
+    walls = back_to_wall(room.boxes, room.outline, 0.1, np.radians(15))
+    assert walls[[bed, ns, desk]].all() and not walls[chair]
+
+
+def test_checks_are_learned_from_the_training_rooms(learned):
+    checks, _ = learned
+    pairs = {(c["anchor"], c["target"]): c for c in checks["checks"] if c["kind"] == "pair"}
+    assert pairs[("bed", "nightstand")]["region"] == "side_back" and pairs[("bed", "nightstand")]["gap"] == 0.15
+    assert pairs[("desk", "chair")]["facing"] == "faces"
+    assert {"bed", "desk", "nightstand"} <= {c["target"] for c in checks["checks"] if c["kind"] == "wall"}
+    assert checks["contents"]["max_count"]["bed"] == 1 and "nightstand" in checks["contents"]["required"]
+
+
+def test_a_nightstand_at_the_foot_and_a_chair_facing_away_fail_their_checks(learned):
+    checks, cfg = learned
+    good = functional.score_room(bedroom(0.1), checks, cfg)
+    assert good["fn:nightstand@bed"] == 1.0 and good["fn:chair@desk"] == 1.0 and good["functional_all"] == 1.0
+    foot = functional.score_room(bedroom(0.1, nightstand_y=2.2), checks, cfg)
+    assert foot["fn:nightstand@bed"] == 0.0 and foot["functional_all"] == 0.0
+    away = functional.score_room(bedroom(0.1, chair_yaw=0.0), checks, cfg)
+    assert away["fn:chair@desk"] == 0.0 and away["fn:nightstand@bed"] == 1.0
+
+
+def test_implausible_contents_are_flagged(learned):
+    checks, cfg = learned
+    two_beds = functional.score_room(bedroom(0.3, beds=2, nightstands=1), checks, cfg)
+    assert two_beds["contents_excess"] == 1.0 and two_beds["contents_missing"] == 0.0
+    none = functional.score_room(bedroom(0.0, nightstands=0), checks, cfg)
+    assert none["contents_missing"] == 1.0 and np.isnan(none["fn:nightstand@bed"]) and none["functional_all"] == 0.0
+
+
+def test_the_perturbations_do_what_they_say():
+    room = bedroom()
+    rng = np.random.default_rng(0)
+    moved = perturb.jitter(room, 0.3, rng)
+    assert np.allclose(np.linalg.norm(moved.boxes[:, :2] - room.boxes[:, :2], axis=1), 0.3)
+    assert np.allclose(moved.poses[:, :2] - room.poses[:, :2], moved.boxes[:, :2] - room.boxes[:, :2])
+    turned = perturb.turns(room, rng)
+    assert np.allclose(turned.boxes[:, :2], room.boxes[:, :2]) and not np.allclose(turned.boxes[:, 6], room.boxes[:, 6])
+    shuffled = perturb.shuffle(room, np.random.default_rng(3))
+    assert sorted(shuffled.categories) == sorted(room.categories) and shuffled.categories != room.categories
+    placed = perturb.placement(room, rng)
+    assert np.all((placed.boxes[:, :2] > 0) & (placed.boxes[:, :2] < 4))
+    assert np.allclose(np.mod(placed.boxes[:, 6], np.pi / 2), 0) or np.allclose(np.mod(placed.boxes[:, 6], np.pi / 2), np.pi / 2)
+    copies = perturb.perturbed([room, bedroom(room_id="r1")], "turns", 0.0, 3, seed=0)
+    assert [r.room_id for r in copies] == [f"r{k}~turns{c}" for k in range(2) for c in range(3)]
+    assert room.boxes[0, 6] == bedroom().boxes[0, 6]  # the originals are untouched
+
+
+def test_the_power_check_fails_on_a_missed_perturbation_or_a_biased_control():
+    cfg = default_config()["evaluate"]["power"]
+    score = lambda a: {"accuracy": a}
+    good = {"jitter_0.1": score(55), "jitter_0.3": score(70), "shuffle": score(80), "turns": score(95),
+            "placement": score(92), power.CONTROL: score(52)}
+    assert power.verdict(good, cfg)["passed"]
+    assert power.verdict({**good, "placement": score(85)}, cfg)["missed"] == ["placement"]
+    assert not power.verdict({**good, power.CONTROL: score(58)}, cfg)["passed"]
+
+
+def _rows(n, colliding, rng):
+    """Per-room rows: ``colliding`` is each room's chance of one colliding object (of 5)."""
+    return pd.DataFrame({"objects": 5, "colliding_objects": (rng.random(n) < colliding).astype(int),
+                         "out_of_bounds": 0, "walkable_share": rng.uniform(0.8, 1.0, n), "reachable": 1.0,
+                         f"{intervals.CATEGORY}bed": 1, f"{intervals.CATEGORY}nightstand": rng.integers(1, 3, n)})
+
+
+def test_bootstrap_differences_see_a_real_difference_and_no_false_one():
+    rng = np.random.default_rng(1)
+    sets = {"a": _rows(150, 0.1, rng), "same": _rows(150, 0.1, rng), "worse": _rows(150, 0.6, rng),
+            "real": _rows(80, 0.1, rng)}
+    reps = intervals.bootstrap(sets, "real", lambda f, r: intervals.figures(f, r, 1e-6, []), 200, seed=0)
+    sizes = {k: len(v) for k, v in sets.items()}
+    diff = intervals.differences(reps, "a", sizes, 10)
+    assert not intervals.differences(reps, "a", sizes, 200)["worse"]["object_collision_rate"]["excludes_zero"]
+    assert diff["worse"]["object_collision_rate"]["excludes_zero"]
+    assert diff["worse"]["object_collision_rate"]["low"] > 0
+    assert not diff["same"]["object_collision_rate"]["excludes_zero"]
+    low, high = intervals.intervals(reps)["worse"]["object_collision_rate"]
+    assert low < intervals.figures(sets["worse"], sets["real"], 1e-6, [])["object_collision_rate"] < high
