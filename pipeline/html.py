@@ -10,8 +10,8 @@ The API (kept small and stable; the CSV of a table stays the file for programs, 
 
 Every page is self-contained (inline CSS and a few lines of inline JavaScript, no network resource) and every text
 is HTML-escaped. A click on a column header sorts the rows by that column (a second click reverses): numbers by
-the exact value in the cell's ``data-value`` (shown rounded to 4 significant digits, integers whole), a text led by
-a number (an interval ``"0.12 [0.10, 0.15]"``) by that number, other text alphabetically; empty cells (NaN, None)
+the exact value in the cell's ``data-value`` (shown rounded to 4 significant digits, integers whole), a number with
+its interval (``"0.12 [0.10, 0.15]"``) by that number, other text alphabetically; empty cells (NaN, None)
 sort last. ``marks`` is a frame of the table's index and columns holding a short string per cell (``""`` or NaN for
 none): a marked cell is highlighted (CSS class ``mark``), shows its mark after the value and as its tooltip.
 ``notes`` maps a column name to its explanation: the header's tooltip and a list under the table. An unnamed
@@ -31,7 +31,9 @@ import pandas as pd
 
 from .tables import write_atomic
 
-LEADING_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
+NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+# a number, or a number and its interval ("0.12 [0.1, 0.15]"): sorted by the number; any other text as text
+LEADING_NUMBER = re.compile(rf"\s*({NUM})(?:\s*\[\s*{NUM}\s*,\s*{NUM}\s*\])?\s*")
 
 CSS = """
 body { font: 14px/1.4 system-ui, -apple-system, "Segoe UI", sans-serif; color: #1e293b; background: #fff; margin: 1em; }
@@ -107,7 +109,7 @@ def cell(value) -> tuple[str, str | None]:
         text = str(value)
         if not text.strip():
             return text, ""
-        lead = LEADING_NUMBER.match(text)
+        lead = LEADING_NUMBER.fullmatch(text)
         return text, (repr(float(lead.group(1))) if lead else None)
     if isinstance(value, numbers.Integral):
         return str(int(value)), str(int(value))

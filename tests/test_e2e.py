@@ -253,8 +253,10 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
             assert m["goals"].get("sca_at_most_60") in (None, "inconclusive")
         for check in m["checks"]:  # every functional check is a figure of every set, with its interval
             assert all(check in s and len(s["intervals"][check]) == 2 for s in m["sets"].values())
-        diff = m["differences"]["vs_real_heldout"]["planit"]["category_kl"]
-        assert diff["low"] <= diff["high"] and isinstance(diff["excludes_zero"], bool)
+        diff = m["differences"]["vs_real_heldout"]["planit"]
+        assert diff["walkable_share"]["low"] <= diff["walkable_share"]["high"]
+        assert isinstance(diff["walkable_share"]["excludes_zero"], bool)
+        assert "category_kl" not in diff  # a distance to the real rooms: beside its floor, not a difference
         assert set(m["floors"]) == {"category_kl", "count_distance"} and m["goals"]
         assert all(set(s["rules"]) == set(RULES) for s in m["sets"].values())  # the generator's rules, re-extracted
         rows = pd.read_parquet(res / "eval" / room_type / "scenes.parquet")
@@ -336,25 +338,37 @@ def test_the_report_renders_in_headless_chromium_and_its_gallery_images_load(run
     assert shot.stat().st_size > 10_000
 
 
-def test_the_report_shows_its_tables_as_html_that_sorts_on_a_header_click(run_dir, tmp_path):
-    """Table 1 opened from the report's menu: Snakemake shows an HTML result in an iframe (a data: URL); its cells
-    hold the CSV's numbers, and a click on a header sorts the rows."""
+def _browser(tmp_path):
+    """Headless Chromium through chromedriver (the test skips where Debian's packages are missing)."""
     from webdriver import CHROMEDRIVER, CHROMIUM, Browser
 
     if not (CHROMIUM and CHROMEDRIVER):
         pytest.skip("Debian's chromium and chromium-driver are not installed (make test installs them where it can)")
+    return Browser(tmp_path / "profile")
+
+
+def _show_in_frame(browser, report, menu: list[str], eye) -> None:
+    """Open the report, click through the ``menu`` texts, click the eye button ``eye()`` returns, and switch into
+    the iframe that Snakemake shows an HTML result in (a data: URL)."""
+    browser.open(report.as_uri())
+    for text in menu:
+        browser.click_text(text)
+    browser.click(eye())
+    frame = browser.wait_for(lambda: browser.elements("iframe"), timeout=20)
+    assert frame, "no iframe shows the page"
+    browser.frame(frame[0])
+
+
+def test_the_report_shows_its_tables_as_html_that_sorts_on_a_header_click(run_dir, tmp_path):
+    """Table 1 opened from the report's menu: Snakemake shows an HTML result in an iframe (a data: URL); its cells
+    hold the CSV's numbers, and a click on a header sorts the rows."""
     csv = pd.read_csv(run_dir / "results/graphs/ingested/report/table1.csv")
-    report = _report(run_dir)
     rows = ("return Array.from(document.querySelectorAll('table.sortable tbody tr'))"
             ".map(r => Array.from(r.cells).map(c => [c.textContent, c.getAttribute('data-value')]))")
-    browser = Browser(tmp_path / "profile")
+    browser = _browser(tmp_path)
     try:
-        browser.open(report.as_uri())
-        browser.click_text("2. Graphs")
-        browser.click(browser.find("//tr[td[normalize-space(text())='Table 1']]//a[@iconname='eye']"))
-        frame = browser.wait_for(lambda: browser.elements("iframe"), timeout=20)
-        assert frame, "no iframe shows the table"
-        browser.frame(frame[0])
+        _show_in_frame(browser, _report(run_dir), ["2. Graphs"],
+                       lambda: browser.find("//tr[td[normalize-space(text())='Table 1']]//a[@iconname='eye']"))
         shown = browser.wait_for(lambda: browser.run(rows), timeout=20)
         heads = browser.run("return Array.from(document.querySelectorAll('th')).map(h => h.textContent)")
         browser.click(browser.elements("th")[heads.index("nodes")])
@@ -384,24 +398,13 @@ def test_the_report_shows_its_tables_as_html_that_sorts_on_a_header_click(run_di
 def test_the_report_shows_every_method_beside_the_real_rooms_with_intervals(run_dir, tmp_path):
     """The evaluation's page opened from the report's menu: its first table holds metrics.json's figures with their
     bootstrap intervals, one row per method and one for the real rooms."""
-    from webdriver import CHROMEDRIVER, CHROMIUM, Browser
-
-    if not (CHROMIUM and CHROMEDRIVER):
-        pytest.skip("Debian's chromium and chromium-driver are not installed (make test installs them where it can)")
     metrics = json.loads((run_dir / "results/eval/bedroom/metrics.json").read_text())
-    report = _report(run_dir)
     rows = ("return Array.from(document.querySelector('table.sortable').querySelectorAll('tbody tr'))"
             ".map(r => Array.from(r.cells).map(c => c.textContent))")
-    browser = Browser(tmp_path / "profile")
-    try:
-        browser.open(report.as_uri())
-        browser.click_text("5. Evaluation")
-        browser.click_text("bedroom")
-        browser.click_text("metrics")  # two figures of a room type become a toggle (Snakemake's layout)
-        browser.click(browser.elements("tbody tr a[iconname='eye']")[0])
-        frame = browser.wait_for(lambda: browser.elements("iframe"), timeout=20)
-        assert frame, "no iframe shows the evaluation"
-        browser.frame(frame[0])
+    browser = _browser(tmp_path)
+    try:  # two figures of a room type become a toggle (Snakemake's layout): "metrics" picks the page
+        _show_in_frame(browser, _report(run_dir), ["5. Evaluation", "bedroom", "metrics"],
+                       lambda: browser.elements("tbody tr a[iconname='eye']")[0])
         shown = browser.wait_for(lambda: browser.run(rows), timeout=20)
         heads = browser.run("return Array.from(document.querySelector('table.sortable').querySelectorAll('th'))"
                             ".map(h => h.textContent)")

@@ -117,10 +117,33 @@ def test_bootstrap_differences_see_a_real_difference_and_no_false_one():
             "real": _rows(80, 0.1, rng)}
     reps = intervals.bootstrap(sets, "real", lambda f, r: intervals.figures(f, r, 1e-6, []), 200, seed=0)
     sizes = {k: len(v) for k, v in sets.items()}
-    diff = intervals.differences(reps, "a", sizes, 10)
-    assert not intervals.differences(reps, "a", sizes, 200)["worse"]["object_collision_rate"]["excludes_zero"]
+    diff = intervals.differences(reps, "a", sizes, 10, "real")
+    assert not intervals.differences(reps, "a", sizes, 200, "real")["worse"]["object_collision_rate"]["excludes_zero"]
+    to_real = intervals.differences(reps, "real", sizes, 10, "real")
+    assert "category_kl" not in to_real["a"] and "object_collision_rate" in to_real["a"]  # a distance to itself is 0
+    assert "category_kl" in diff["worse"] and "category_kl" not in diff["real"]
     assert diff["worse"]["object_collision_rate"]["excludes_zero"]
     assert diff["worse"]["object_collision_rate"]["low"] > 0
     assert not diff["same"]["object_collision_rate"]["excludes_zero"]
     low, high = intervals.intervals(reps)["worse"]["object_collision_rate"]
     assert low < intervals.figures(sets["worse"], sets["real"], 1e-6, [])["object_collision_rate"] < high
+
+
+def test_a_set_with_no_rooms_scores_to_empty_rows_and_undefined_figures(learned):
+    """Every scene of a method failed: its rows are empty (with every column), its figures NaN, nothing crashes."""
+    from pipeline import tables
+    from pipeline.evaluation.evaluate import EXTRA, room_rows
+    from pipeline.evaluation.sets import RoomSet
+
+    checks, cfg = learned
+    config = default_config()
+    config["evaluate"]["functional"] = cfg
+    index = {c: k for k, c in enumerate(["bed", "chair", "desk", "nightstand"])}
+    empty = room_rows(RoomSet("none", [], []), checks, index, {}, set(), np.zeros((0, 64, 64), np.int16), [], config)
+    real = room_rows(RoomSet("real", [bedroom()], [[None] * 5]), checks, index, {}, set(),
+                     np.zeros((0, 64, 64), np.int16), [], config)
+    assert len(empty) == 0 and set(tables.SCHEMAS["eval_scenes"].names) <= set(empty.columns)
+    names = [functional.check_name(c) for c in checks["checks"]]
+    figures = intervals.figures(empty, real, 1e-6, EXTRA + names)
+    assert np.isnan(figures["walkable_share"]) and np.isnan(figures["fn:nightstand@bed"])
+    assert intervals.figures(real, real, 1e-6, EXTRA + names)["fn:nightstand@bed"] == 1.0

@@ -39,11 +39,13 @@ def test_missing_values_are_empty_cells_that_sort_last():
     assert 'data-value=""' in table_html(pd.DataFrame({"d": [pd.NaT]}), "t")
 
 
-def test_text_led_by_a_number_sorts_by_that_number_other_text_as_text():
-    cells = _cells(table_html(pd.DataFrame({"ci": ["0.12 [0.10, 0.15]", "-3e-2 (n=4)", "kitchen", "True"]}), "t"))
+def test_a_number_with_its_interval_sorts_by_that_number_other_text_as_text():
+    frame = pd.DataFrame({"ci": ["0.12 [0.10, 0.15]", "-3e-2 [-4e-2, 1]", "kitchen", "True", "3D-FRONT rooms"]})
+    cells = _cells(table_html(frame, "t"))
     assert cells[0] == '<td data-value="0.12" class="num">0.12 [0.10, 0.15]</td>'
     assert cells[1].startswith('<td data-value="-0.03" class="num">')
     assert cells[2] == "<td>kitchen</td>" and cells[3] == "<td>True</td>"  # no data-value: sorted as text
+    assert cells[4] == "<td>3D-FRONT rooms</td>"  # led by a digit, but not a number: text
 
 
 def test_marks_highlight_their_cells_with_a_tooltip_and_a_visible_mark():

@@ -12,10 +12,17 @@ def category_kl(real: Sequence[str], generated: Sequence[str], eps: float = 1e-6
     """KL(p || q) of the category frequencies over all objects: p from ``real``, q from ``generated`` (one category
     label per object), ``sum p (log(p + eps) - log(q + eps))`` over the categories of both."""
     cats = sorted(set(real) | set(generated))
-    if not cats:
+    count = lambda labels: np.array([Counter(labels)[c] for c in cats], dtype=float)
+    return category_kl_counts(count(real), count(generated), eps)
+
+
+def category_kl_counts(real: np.ndarray, generated: np.ndarray, eps: float = 1e-6) -> float:
+    """:func:`category_kl` from two category count vectors ``(c,)`` over the same categories (only those of either
+    set count)."""
+    keep = (real > 0) | (generated > 0)
+    if not keep.any():
         return 0.0
-    p = _frequencies(real, cats)
-    q = _frequencies(generated, cats)
+    p, q = real[keep] / max(real.sum(), 1), generated[keep] / max(generated.sum(), 1)
     return float(np.sum(p * (np.log(p + eps) - np.log(q + eps))))
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections import Counter
 
+import numpy as np
 import pandas as pd
 
 from .. import tables
@@ -41,8 +42,7 @@ def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: 
             for name, rs in by_name.items()}
     sca, check = classifier_scores(config, by_name, train, real, index, threads)
     for name, score in sca.items():
-        if name in sets:
-            sets[name]["sca"] = score
+        sets[name]["sca"] = score
     if config["source"] == "procedural":  # the generator's own rules: an oracle only for its rooms
         checker = Checker(meshes, box_models, symmetry, {**config["extract"], "floor_contact": config["floor_contact"]},
                           intersector_class(config["extract"]["backend"]), {})
@@ -51,8 +51,9 @@ def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: 
     fl = floors(train, real, len(gen[0].rooms), ev, config["seed"])
     metrics = {"room_type": room_type, "sets": sets, "floors": fl, "functional": learned, "checks": checks,
                "differences": {f"vs_{ref}": intervals.differences(reps, ref, {n: len(f) for n, f in rows.items()},
-                                                                   ev["bootstrap_min_rooms"]) for ref in (gen[0].name, REAL)},
-               "power": {"scores": {k: v for k, v in sca.items() if k not in sets}, **check},
+                                                                   ev["bootstrap_min_rooms"], REAL)
+                               for ref in (gen[0].name, REAL)},
+               "power": check,
                "train_nn_similarity": train_similarity(train_maps, ev["similarity_sample"], config["seed"]),
                "real_train_rooms": len(train.rooms), "settings": {k: ev[k] for k in SETTINGS},
                "categories": sorted(index)}
@@ -67,7 +68,8 @@ def room_rows(rs: RoomSet, learned: dict, index: dict, meshes: dict, box_models:
     scored = pd.DataFrame(scene_rows(rs, meshes, box_models, train_maps, train_ids, index, config),
                           columns=[c for c in tables.SCHEMAS["eval_scenes"].names if c not in functional.ROOM_COLUMNS])
     fn = pd.DataFrame([functional.score_room(r, learned, config["evaluate"]["functional"]) for r in rs.rooms],
-                      index=scored.index)
+                      index=scored.index, columns=[*map(functional.check_name, learned["checks"]),
+                                                   *functional.ROOM_COLUMNS], dtype=float)
     counts = pd.DataFrame([Counter(r.categories) for r in rs.rooms], index=scored.index,
                           columns=sorted(index)).fillna(0).add_prefix(intervals.CATEGORY)
     return pd.concat([scored, fn, counts], axis=1)
@@ -75,20 +77,21 @@ def room_rows(rs: RoomSet, learned: dict, index: dict, meshes: dict, box_models:
 
 def classifier_scores(config: dict, by_name: dict, train: RoomSet, real: RoomSet, index: dict,
                       threads: int) -> tuple[dict, dict]:
-    """The classifier's accuracy for every generated set, every power set and the real-vs-real control, and the
-    power check's verdict."""
+    """The classifier's accuracy for every generated set, and for every power set and the real-vs-real control
+    with the power check's verdict."""
     from .sca import sca_scores
 
     ev = config["evaluate"]
     colours = render.palette(sorted(index))
     rgb = lambda rooms: render.classifier_images(rooms, index, colours, ev["render"])
-    real_test = rgb(real.rooms)
-    known = power.power_sets(real.rooms, ev["power"], config["seed"])
-    sets = {name: (rgb(rs.rooms), None) for name, rs in by_name.items() if name != REAL}
-    sets |= {name: (rgb(rooms), groups) for name, (rooms, groups) in known.items()}
-    scores = sca_scores((rgb(train.rooms), real_test), sets, ev["sca"], threads, config["seed"])
-    size = max(len(rs.rooms) for rs in by_name.values())  # as many as the largest set scored (half the training rooms at most)
-    kept, back = power.control_split(train.rooms, size, config["seed"])
-    scores |= sca_scores((rgb(kept), real_test), {power.CONTROL: (rgb(back), None)}, ev["sca"], threads,
-                         config["seed"])
-    return scores, power.verdict(scores, ev["power"])
+    train_images, real_test = rgb(train.rooms), rgb(real.rooms)
+    methods = {name: (rgb(rs.rooms), None, None) for name, rs in by_name.items() if name != REAL}
+    scores = sca_scores((train_images, real_test), methods, ev["sca"], threads, config["seed"])
+    own = np.arange(len(real.rooms))  # a power set's copies are grouped by the held-out room they come from
+    known = {name: (rgb(rooms), groups, own)
+             for name, (rooms, groups) in power.power_sets(real.rooms, ev["power"], config["seed"]).items()}
+    checks = sca_scores((train_images, real_test), known, ev["sca"], threads, config["seed"])
+    kept, back = power.control_split(len(train.rooms), max(len(rs.rooms) for rs in by_name.values()), config["seed"])
+    checks |= sca_scores((train_images[kept], real_test), {power.CONTROL: (train_images[back], None, None)},
+                         ev["sca"], threads, config["seed"])
+    return scores, {"scores": checks, **power.verdict(checks, ev["power"])}

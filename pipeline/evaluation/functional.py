@@ -147,7 +147,7 @@ def check_name(check: dict) -> str:
 def score_room(room: RoomInput, learned: dict, cfg: dict) -> dict:
     """One room's outcome per check (1.0 pass, 0.0 fail, NaN where the room lacks its categories), its contents
     (``contents_excess``, ``contents_missing``) and ``functional_all`` (1.0: every applicable check passes)."""
-    row, preds = {}, {}
+    row = {}
     pair = [c for c in learned["checks"] if c["kind"] == "pair"]
     preds = [Predicate(c["region"], c["gap"], c["facing"]) for c in pair]
     masks = predicate_masks(room, preds, cfg) if pair else None

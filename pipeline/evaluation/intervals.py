@@ -9,19 +9,9 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
-from .distributions import count_distance
+from .distributions import category_kl_counts, count_distance
 
 CATEGORY = "cat:"  # prefix of the per-room category count columns
-
-
-def category_kl_counts(real: np.ndarray, generated: np.ndarray, eps: float) -> float:
-    """ATISS's category KL from two category count vectors ``(c,)`` over the same categories (only those of either
-    set count), as :func:`distributions.category_kl`."""
-    keep = (real > 0) | (generated > 0)
-    if not keep.any():
-        return 0.0
-    p, q = real[keep] / max(real.sum(), 1), generated[keep] / max(generated.sum(), 1)
-    return float(np.sum(p * (np.log(p + eps) - np.log(q + eps))))
 
 
 def _mean(frame: pd.DataFrame, column: str) -> float:
@@ -73,17 +63,22 @@ def intervals(reps: dict[str, pd.DataFrame]) -> dict[str, dict[str, list[float]]
     return {name: {col: list(interval(frame[col])) for col in frame.columns} for name, frame in reps.items()}
 
 
-def differences(reps: dict[str, pd.DataFrame], reference: str, sizes: dict[str, int],
-                min_rooms: int) -> dict[str, dict[str, dict]]:
+RELATIVE = ("category_kl", "count_distance")  # distances to the real rooms: no difference taken with the real set
+
+
+def differences(reps: dict[str, pd.DataFrame], reference: str, sizes: dict[str, int], min_rooms: int,
+                real: str) -> dict[str, dict[str, dict]]:
     """``set -> figure -> {low, high, excludes_zero}``: each set's replicate figures minus the reference set's;
     ``excludes_zero`` only where both sets hold at least ``min_rooms`` rooms (``sizes``: rooms per set), since a
-    handful of rooms resamples to a degenerate interval."""
+    handful of rooms resamples to a degenerate interval. The :data:`RELATIVE` figures are left out wherever the
+    ``real`` set is one side (its distance to itself is 0 by definition; they sit beside the sampling floor)."""
     out = {}
     for name, frame in reps.items():
         if name == reference:
             continue
         diff = frame - reps[reference]
         enough = min(sizes[name], sizes[reference]) >= min_rooms
+        columns = [c for c in frame.columns if real not in (name, reference) or c not in RELATIVE]
         out[name] = {col: (lambda lo, hi: {"low": lo, "high": hi, "excludes_zero": bool(enough and (lo > 0 or hi < 0))})(
-            *interval(diff[col])) for col in frame.columns}
+            *interval(diff[col])) for col in columns}
     return out

@@ -6,6 +6,8 @@ from __future__ import annotations
 import pandas as pd
 
 from ..html import Table, page
+from .functional import check_name
+from .sets import REAL
 
 FIGURES = {"scenes": "rooms scored (placed)", "attempted": "rooms the method attempted", "category_kl": "category KL to the real rooms (ATISS)", "count_distance": "object-count TV distance",
            "object_collision_rate": "share of objects colliding (mesh penetration)",
@@ -28,11 +30,9 @@ def _with_interval(value, span) -> str | int | None:
 
 def _marks(metrics: dict, name: str, figure: str) -> str:
     """``P`` where the set differs from the first method, ``R`` where from the real rooms (interval excludes 0)."""
-    out = ""
-    for key, letter in zip(metrics["differences"], "PR"):
-        if metrics["differences"][key].get(name, {}).get(figure, {}).get("excludes_zero"):
-            out += letter
-    return out
+    first = list(metrics["sets"])[0]
+    return "".join(letter for ref, letter in ((first, "P"), (REAL, "R"))
+                   if metrics["differences"][f"vs_{ref}"].get(name, {}).get(figure, {}).get("excludes_zero"))
 
 
 def figure_table(metrics: dict, figures: list[str]) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -63,14 +63,14 @@ def check_rows(metrics: dict) -> pd.DataFrame:
         what = ("back to a wall" if c["kind"] == "wall" else
                 f"{c['region']} of a {c['anchor']}" + (f", within {c['gap']:g} m" if c.get("gap") else "")
                 + ("" if c["facing"] == "any" else f", {c['facing']} it"))
-        rows.append({"check": f"fn:{c['target']}@{c.get('anchor', 'wall')}", "every": c["target"], "stands": what,
+        rows.append({"check": check_name(c), "every": c["target"], "stands": what,
                      "training rooms": c["train_rooms"], "training share": c["train_share"]})
     return pd.DataFrame(rows, columns=["check", "every", "stands", "training rooms", "training share"]).set_index("check")
 
 
 def evaluation_page(metrics: dict) -> str:
     """The room type's evaluation page (HTML)."""
-    first, real = list(metrics["sets"])[0], list(metrics["sets"])[-1]
+    first, real = list(metrics["sets"])[0], REAL
     figures, fmarks = figure_table(metrics, list(FIGURES))
     checks, cmarks = figure_table(metrics, metrics["checks"])
     goals = pd.DataFrame({"goal": list(metrics["goals"]), "met": [str(v) for v in metrics["goals"].values()]})

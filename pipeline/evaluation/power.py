@@ -26,11 +26,11 @@ def power_sets(real: list[RoomInput], cfg: dict, seed: int) -> dict[str, tuple[l
             for p in cfg["perturbations"]}
 
 
-def control_split(train: list[RoomInput], size: int, seed: int) -> tuple[list[RoomInput], list[RoomInput]]:
-    """The training rooms split into the classifier's real class and ``size`` held-back real rooms (at most half)."""
-    perm = np.random.default_rng([seed, 4242]).permutation(len(train))
-    back = min(size, len(train) // 2)
-    return [train[k] for k in perm[back:]], [train[k] for k in perm[:back]]
+def control_split(rooms: int, size: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Indices of the training rooms kept in the classifier's real class and of ``size`` held back (at most half)."""
+    perm = np.random.default_rng([seed, 4242]).permutation(rooms)
+    back = min(size, rooms // 2)
+    return np.sort(perm[back:]), np.sort(perm[:back])
 
 
 def verdict(scores: dict[str, dict], cfg: dict) -> dict:

@@ -4,7 +4,7 @@ one room stay together); the classifier trains on the real training renders agai
 held-out real renders against the other, then the halves swap. Batches hold as many real as other renders, each
 batch turned and mirrored at random (a turned room is still a room). The score is the balanced accuracy over both
 folds' test predictions, folded to ``max(a, 100 - a)`` (a classifier that is reliably wrong still tells the sets
-apart), with a bootstrap 95% interval over the test renders. 50% is ideal."""
+apart), with a bootstrap 95% interval over the test rooms. 50% is ideal."""
 from __future__ import annotations
 
 import numpy as np
@@ -60,41 +60,65 @@ def halves(groups: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np
     return np.flatnonzero(mask), np.flatnonzero(~mask)
 
 
-def balanced_accuracy(real_hits: np.ndarray, other_hits: np.ndarray) -> float:
-    """Mean of the shares of real and of other test renders classified right (%), folded to at least 50."""
-    acc = 50.0 * (real_hits.mean() + other_hits.mean())
-    return max(acc, 100.0 - acc)
+def accuracy(real_hits: np.ndarray, other_hits: np.ndarray) -> float:
+    """Mean of the shares of real and of other test renders classified right (%), not folded."""
+    return 50.0 * (real_hits.mean() + other_hits.mean())
+
+
+def folded(low: float, point: float, high: float) -> tuple[float, float, float]:
+    """An accuracy and its interval folded at 50: ``max(a, 100 - a)``; an interval across 50 becomes
+    ``[50, max(100 - low, high)]``."""
+    if low >= 50.0:
+        return low, point, high
+    if high <= 50.0:
+        return 100.0 - high, 100.0 - point, 100.0 - low
+    return 50.0, max(point, 100.0 - point), max(100.0 - low, high)
+
+
+def grouped_bootstrap(real: list[np.ndarray], other: list[np.ndarray], repeats: int, seed: int) -> np.ndarray:
+    """``(repeats,)`` unfolded accuracies, resampling rooms (each a group of predictions) on both sides."""
+    rng = np.random.default_rng([seed, 5151])
+    pick = lambda groups: np.concatenate([groups[k] for k in rng.integers(len(groups), size=len(groups))])
+    return np.array([accuracy(pick(real), pick(other)) for _ in range(repeats)])
 
 
 def sca(real_train: np.ndarray, real_test: np.ndarray, other: np.ndarray, groups: np.ndarray, cfg: dict,
-        seed: int) -> dict:
-    """The folded balanced accuracy (%) and its bootstrap 95% interval, the first fold's training renders and all
-    test predictions (real test renders are predicted once per fold). Images ``(n, s, s, 3)`` in [0, 1]."""
+        seed: int, real_groups: np.ndarray | None = None) -> dict:
+    """The folded balanced accuracy (%) and its bootstrap 95% interval (rooms resampled: a room's copies and a real
+    room's predictions of both folds together), the first fold's training renders and all test predictions.
+    ``real_groups``: the group of each real test render where the other set is made from them (the power check):
+    each fold then tests only the real rooms of its test half, never the originals of what it trained on. Images
+    ``(n, s, s, 3)`` in [0, 1]."""
     if min(len(real_train), len(real_test)) < 1 or len(np.unique(groups)) < 2:
         return {"accuracy": float("nan"), "low": float("nan"), "high": float("nan"), "train": 0, "test": 0}
     device = pick_device(cfg["device"])
     t = lambda a: torch.as_tensor(np.ascontiguousarray(np.asarray(a, np.float32).transpose(0, 3, 1, 2)), device=device)
     real_train, real_test, other = t(real_train), t(real_test), t(other)
-    rng = np.random.default_rng([seed, 5150])
-    real_hits, other_hits = [], []
-    first, second = halves(groups, rng)
+    first, second = halves(groups, np.random.default_rng([seed, 5150]))
+    real_of = np.arange(len(real_test)) if real_groups is None else np.asarray(real_groups)
+    real_hits: dict = {}
+    other_hits: dict = {}
     for fold, (fit, test) in enumerate(((first, second), (second, first))):
-        pred = fit_and_predict(real_train, other[fit], torch.cat([real_test, other[test]]), cfg, seed * 1000 + fold)
-        real_hits.append(pred[:len(real_test)])
-        other_hits.append(~pred[len(real_test):])
-    real_hits, other_hits = np.concatenate(real_hits), np.concatenate(other_hits)
-    boot = np.random.default_rng([seed, 5151])
-    reps = [balanced_accuracy(real_hits[boot.integers(len(real_hits), size=len(real_hits))],
-                              other_hits[boot.integers(len(other_hits), size=len(other_hits))])
-            for _ in range(cfg["bootstrap"])]
-    return {"accuracy": round(balanced_accuracy(real_hits, other_hits), 3),
-            "low": round(float(np.percentile(reps, 2.5)), 3), "high": round(float(np.percentile(reps, 97.5)), 3),
-            "train": len(real_train) + len(first), "test": len(real_hits) + len(other_hits)}
+        shown = np.arange(len(real_test)) if real_groups is None else np.flatnonzero(np.isin(real_of, groups[test]))
+        pred = fit_and_predict(real_train, other[fit], torch.cat([real_test[shown], other[test]]), cfg,
+                               seed * 1000 + fold)
+        for k, hit in zip(shown, pred[:len(shown)]):
+            real_hits.setdefault(int(k), []).append(hit)
+        for g, hit in zip(groups[test], ~pred[len(shown):]):
+            other_hits.setdefault(g, []).append(hit)
+    real_list = [np.asarray(v) for v in real_hits.values()]
+    other_list = [np.asarray(v) for v in other_hits.values()]
+    point = accuracy(np.concatenate(real_list), np.concatenate(other_list))
+    reps = grouped_bootstrap(real_list, other_list, cfg["bootstrap"], seed)
+    low, acc, high = folded(min(float(np.percentile(reps, 2.5)), point), point,
+                            max(float(np.percentile(reps, 97.5)), point))  # widened to hold the estimate, if need be
+    return {"accuracy": round(acc, 3), "low": round(low, 3), "high": round(high, 3),
+            "train": len(real_train) + len(first), "test": sum(map(len, real_list)) + sum(map(len, other_list))}
 
 
 def sca_scores(real_maps: tuple[np.ndarray, np.ndarray], sets: dict, cfg: dict, threads: int, seed: int) -> dict:
-    """:func:`sca` of each set ``name -> (images, groups)`` against the real training and held-out renders (groups
-    None: one per image)."""
+    """:func:`sca` of each set ``name -> (images, groups, real_groups)`` against the real training and held-out
+    renders (groups None: one per image; real_groups None: the set is not made from the held-out rooms)."""
     torch.set_num_threads(max(threads, 1))
     return {name: sca(real_maps[0], real_maps[1], images, np.arange(len(images)) if groups is None else groups, cfg,
-                      seed) for name, (images, groups) in sets.items()}
+                      seed, real_groups) for name, (images, groups, real_groups) in sets.items()}
