@@ -55,8 +55,7 @@ def fit_and_predict(real: torch.Tensor, other: torch.Tensor, test: torch.Tensor,
 def halves(groups: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     """Index arrays of two halves of the items, split by group (``groups (m,)``: one id per item)."""
     ids = np.unique(groups)
-    first = set(rng.permutation(ids)[: len(ids) // 2].tolist())
-    mask = np.array([g in first for g in groups])
+    mask = np.isin(groups, rng.permutation(ids)[: len(ids) // 2])
     return np.flatnonzero(mask), np.flatnonzero(~mask)
 
 

@@ -64,11 +64,6 @@ def mesh_scene(mesh: tuple[np.ndarray, np.ndarray], intersector) -> RoomScene:
     return RoomScene([mesh], np.array([0]), np.array([0]), intersector)
 
 
-def inside(mesh: tuple[np.ndarray, np.ndarray], points: np.ndarray, intersector) -> np.ndarray:
-    """``(n,)`` bool: each point inside the mesh ``(vertices (v, 3), faces (f, 3))`` (:func:`inside_scene`)."""
-    return inside_scene(mesh_scene(mesh, intersector), points)
-
-
 def inside_scene(scene: RoomScene, points: np.ndarray) -> np.ndarray:
     """``(n,)`` bool: each point ``(n, 3)`` inside the scene's mesh, by the parity of the crossings of a ray in each
     of :data:`DIRECTIONS`, the majority of the three deciding (the third ray is cast only where the first two
