@@ -22,20 +22,30 @@ def arguments(doc: str, workdir: Path = OUT) -> argparse.ArgumentParser:
 
 
 def search_flags(ap: argparse.ArgumentParser) -> None:
-    """``--[no-]early-backtrack`` and ``--restarts N``: the search settings a bench may set (default: the config's)."""
+    """``--[no-]early-backtrack``, ``--restarts N``, ``--[no-]pose-rules`` and ``--[no-]keep-relations``: the search
+    settings a bench may set (default: the config's)."""
     ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
     ap.add_argument("--restarts", type=int)
+    ap.add_argument("--pose-rules", action=argparse.BooleanOptionalAction)
+    ap.add_argument("--keep-relations", action=argparse.BooleanOptionalAction)
 
 
 def search_overrides(args) -> dict:
     """The ``instantiate`` keys :func:`search_flags` set on the command line."""
-    return {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts)) if v is not None}
+    out = {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts),
+                             ("keep_relations", args.keep_relations)) if v is not None}
+    return out | ({} if args.pose_rules is None else {"pose_rules": {**POSE_RULES, "enabled": args.pose_rules}})
 
 
 def search_suffix(args) -> str:
     """The report name's suffix for the search flags given (none: the config's settings)."""
     return ({True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
-            + (f"_restarts{args.restarts}" if args.restarts is not None else ""))
+            + (f"_restarts{args.restarts}" if args.restarts is not None else "")
+            + {True: "_pose_rules", False: "_no_pose_rules", None: ""}[args.pose_rules]
+            + {True: "_keep_relations", False: "_no_keep_relations", None: ""}[args.keep_relations])
+
+
+POSE_RULES = config_mod.load(ROOT / "config" / "config.yaml")["instantiate"]["pose_rules"]
 
 
 def default_config() -> dict:

@@ -3,12 +3,13 @@ good the placement networks are on held-out rooms (location: CFCN mass near the 
 network's most likely bin against the face-away-from-the-wall rule).
 
     .venv/bin/python bench/instantiate.py [--room-type bedroom] [--scenes 30] [--probes 60] [--no-confirm]
-        [--early-backtrack | --no-early-backtrack] [--restarts N] [--density-cache N]
+        [--early-backtrack | --no-early-backtrack] [--restarts N] [--pose-rules | --no-pose-rules] [--density-cache N]
 
 ``--no-confirm``: the collision check on the coarse per-attempt grid alone, without measuring the pairs it clears
 again on the evaluation's grid (what the search did before); either way the placed rooms' colliding objects are
-counted by the evaluation's own test. ``--[no-]early-backtrack`` and ``--restarts N`` set
-``instantiate.early_backtrack`` and ``instantiate.restarts`` (default: the config's). ``--density-cache N``: keep N location densities (1: only the room at hand, what a backtrack loses); the
+counted by the evaluation's own test. ``--[no-]early-backtrack``, ``--restarts N`` and ``--[no-]pose-rules`` set
+``instantiate.early_backtrack``, ``instantiate.restarts`` and ``instantiate.pose_rules.enabled`` (default: the
+config's). The placed rooms are scored by the evaluation's functional checks (learned from the training rooms). ``--density-cache N``: keep N location densities (1: only the room at hand, what a backtrack loses); the
 report counts the densities computed and found again.
 
 Reads a pipeline run's outputs (make pipeline first): the sampled graphs, the corpus tables and
@@ -21,9 +22,11 @@ import statistics
 import zlib
 
 import numpy as np
+import pandas as pd
 import torch
 
 from pipeline import config as config_mod
+from pipeline.evaluation import functional as functional_checks
 from pipeline.evaluation import physical
 from pipeline.learning import checkpoint
 from pipeline.geometry.frames import yaw_to_local
@@ -32,6 +35,7 @@ from pipeline.methods.planit.nets.proposer import NetProposer
 from pipeline.placement.layout import render, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement import scene_metrics
+from pipeline.methods.scenes import plan_loss
 from pipeline.placement.proposers import FaceAway
 from pipeline.placement.search import Grid, anchors_of
 from pipeline import tables
@@ -118,12 +122,16 @@ def main() -> None:
     proposer = instantiate.make_proposer("cfcn", saved, cfg["instantiate"])
     nets = getattr(proposer, "base", proposer)  # the NetProposer, under the relation bands when they are on
     rows, colliding, ev = [], 0, {**cfg["evaluate"]["collision"], "intersector": ctx.checker.intersector}
+    fn_cfg = cfg["evaluate"]["functional"]
+    learned, functional = functional_checks.learn_checks(ctx.corpus.training(), fn_cfg), []
     for plan in plans:
         seed = zlib.crc32(f"{cfg['seed']}/bench/{plan.scene_id}".encode())
         out, walls = instantiate.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
-        rows.append((out.ok, out.seconds, scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker)["consistency"],
-                     out.rejections, out.failures.get("nowhere", 0), out.attempts))
+        metrics = scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker, out.dropped, out.accepted)
+        rows.append((out.ok, out.seconds, metrics["consistency"], out.rejections, out.failures.get("nowhere", 0),
+                     out.attempts, metrics["plan_loss"]))
         if out.ok:
+            functional.append(functional_checks.score_room(out.room, learned, fn_cfg))
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())
     placed = [r for r in rows if r[0]]
     result = {"room_type": args.room_type, "scenes": len(rows), "placed": len(placed),
@@ -137,6 +145,9 @@ def main() -> None:
               "median_seconds_per_scene": round(statistics.median(r[1] for r in rows), 3),
               "median_seconds_placed": round(statistics.median(r[1] for r in placed), 3) if placed else None,
               "mean_consistency_placed": round(float(np.mean([r[2] for r in placed])), 4) if placed else None,
+              "plan_loss_placed": plan_loss(pd.Series([r[6] for r in placed])),
+              "functional_placed": {k: round(float(v), 3) for k, v in
+                                    pd.DataFrame(functional).mean().items()} if functional else None,
               **probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker),
               "machine": platform.processor() or platform.machine(), "threads": 1}
     report(result, args.workdir, f"instantiate_{args.room_type}" + ("_no_confirm" if args.no_confirm else "")

@@ -216,6 +216,10 @@ SCHEMAS["scenes"] = pa.schema([
     _f("found_edges", _I32, doc="of those, found again exactly by extraction"),
     _f("consistency", _F64, doc="found_edges / planned_edges"),
     _f("violation", _F64, doc="mean violation cost of the planned edges (0 found, 0.5 other distance, 1 missing)"),
+    _f("plan_loss", _STR, doc="JSON: the planned edges not found, by relation (support, adjacent, proximal, "
+       "distant) and cause: 'relaxed' (accepted broken once the search's tolerance grew), 'lost_later' (held when its "
+       "object was placed, broken by a later one), 'unplaced' (an end left out); and by what extraction finds instead: "
+       "'distance' (same side, other distance), 'direction' (another side), 'absent' (no such edge)"),
     _f("unplanned_edges", _I32, doc="extracted support or spatial edges at an object that the plan lacks"),
     _f("unplanned_adjacent", _I32, doc="of those, support or adjacent ones"),
     _f("colliding_objects", _I32, doc="objects penetrating another deeper than instantiate.checks.collision"),

@@ -257,3 +257,22 @@ def test_early_stopping_sees_validation_rooms_never_the_held_out_test_rooms():
     assert (len(held), len(val)) == (30, 17)  # 0.15 of 200, then 0.1 of the 170 left
     assert held == graph_data.split_heldout(ids, gm["heldout_fraction"], 0)[1]
     assert splits(0) == (fit, val, held) and splits(1)[1] != val
+
+
+def test_count_caps_and_required_categories_keep_sampled_contents_plausible(bedrooms, model):
+    """With every category capped at one, no sampled graph holds a category twice (at a high temperature, where the
+    uncapped model repeats some); a graph without a required category is rejected by name."""
+    vocab, graphs = bedrooms
+    n_arch = len(graph_data.ARCH)
+    cats = len(vocab.node_classes) - n_arch
+    repeats = lambda gs: sum(len(g.node_class[g.arch.n_arch:]) != len(set(g.node_class[g.arch.n_arch:])) for g in gs)  # noqa: E731
+    free = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0, max_objects=25, max_edges=10)
+    capped = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0, max_objects=25, max_edges=10,
+                            caps=np.ones(cats, int))
+    assert repeats(free) > 0 and repeats(capped) == 0
+    g = capped[0]
+    absent = next(c for c in range(n_arch, len(vocab.node_classes)) if c not in g.node_class)
+    assert "missing_required" in graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch,
+                                                       graph_checks.seen_triples(graphs), {absent})
+    assert "missing_required" not in graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch,
+                                                           graph_checks.seen_triples(graphs), {g.node_class[-1]})

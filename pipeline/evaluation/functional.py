@@ -6,7 +6,6 @@ holds). A check is kept only where the training rooms show it with confidence: t
 share of training rooms is at least ``min_share``."""
 from __future__ import annotations
 
-from collections import Counter
 from dataclasses import asdict, dataclass
 from itertools import product
 
@@ -14,6 +13,7 @@ import numpy as np
 
 from ..geometry.function import REGIONS, back_to_wall, facing_angles, plan_gaps, regions
 from ..room import RoomInput
+from ..room.contents import implausible, learn_contents, wilson_lower
 
 REGION_SETS = {"any": None, "side": ("side_front", "side_back"), **{r: (r,) for r in REGIONS if r != "corner"}}
 FACINGS = ("any", "faces", "away")
@@ -70,15 +70,6 @@ def pair_outcomes(room: RoomInput, masks: np.ndarray, anchor: str, target: str) 
     return masks[:, a][:, :, t].any(axis=1).all(axis=1)
 
 
-def wilson_lower(passed: int, total: int, z: float = 1.96) -> float:
-    """The Wilson score interval's lower bound of a share ``passed / total`` (0 for no trials)."""
-    if total == 0:
-        return 0.0
-    p = passed / total
-    centre = p + z * z / (2 * total)
-    return float((centre - z * np.sqrt(p * (1 - p) / total + z * z / (4 * total * total))) / (1 + z * z / total))
-
-
 def learn_pair_checks(rooms: list[RoomInput], cfg: dict) -> list[dict]:
     """The confident (anchor, target, predicate) checks of the training rooms: per category pair the most specific
     confident predicate (ties: the higher training share), the pairs held by the most rooms first."""
@@ -125,18 +116,10 @@ def learn_wall_checks(rooms: list[RoomInput], cfg: dict) -> list[dict]:
     return out
 
 
-def learn_contents(rooms: list[RoomInput], cfg: dict) -> dict:
-    """Each category's largest count in one training room, and the categories (nearly) every training room holds."""
-    counts = [Counter(r.categories) for r in rooms]
-    cats = sorted({c for r in rooms for c in r.categories})
-    required = [c for c in cats if wilson_lower(sum(c in k for k in counts), len(rooms)) >= cfg["min_share"]]
-    return {"max_count": {c: max(k[c] for k in counts) for c in cats}, "required": required}
-
-
 def learn_checks(rooms: list[RoomInput], cfg: dict) -> dict:
     """Everything the functional checks learn from the training rooms (JSON-ready)."""
     return {"checks": learn_pair_checks(rooms, cfg) + learn_wall_checks(rooms, cfg),
-            "contents": learn_contents(rooms, cfg), "training_rooms": len(rooms)}
+            "contents": learn_contents((r.categories for r in rooms), cfg["min_share"]), "training_rooms": len(rooms)}
 
 
 def check_name(check: dict) -> str:
@@ -158,8 +141,7 @@ def score_room(room: RoomInput, learned: dict, cfg: dict) -> dict:
         o = wall_outcome(room, c["target"], cfg)
         row[check_name(c)] = np.nan if o is None else float(o)
     outcomes = [v for v in row.values() if v == v]
-    counts, cont = Counter(room.categories), learned["contents"]
-    row["contents_excess"] = float(any(n > cont["max_count"].get(c, 0) for c, n in counts.items()))
-    row["contents_missing"] = float(any(c not in counts for c in cont["required"]))
+    excess, missing = implausible(room.categories, learned["contents"])
+    row["contents_excess"], row["contents_missing"] = float(bool(excess)), float(bool(missing))
     row["functional_all"] = float(all(v == 1.0 for v in outcomes) and row["contents_excess"] == 0.0 and row["contents_missing"] == 0.0)
     return row

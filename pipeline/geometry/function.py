@@ -18,15 +18,32 @@ from .polygon import inward_normals, make_ccw, polygon_segments
 REGIONS = ("front", "back", "side_front", "side_back", "corner", "over")
 
 
-def regions(boxes: np.ndarray) -> np.ndarray:
-    """``(n, n)`` index into :data:`REGIONS` of target ``j``'s centre in anchor ``i``'s frame (row: anchor)."""
+def _normalised(boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(n, n)`` each target ``j``'s centre in anchor ``i``'s frame, scaled by the anchor's half extents: ``u``
+    (signed, +x right) and ``v`` (+y front)."""
     b = np.asarray(boxes, float).reshape(-1, 7)
     rel = b[None, :, :2] - b[:, None, :2]  # (anchor, target, 2)
     local = np.einsum("aji,atj->ati", rotation(b[:, 6]), rel)  # R^T (world -> anchor's local)
-    u = np.abs(local[..., 0]) / np.maximum(b[:, None, 3], 1e-9)
-    v = local[..., 1] / np.maximum(b[:, None, 4], 1e-9)
-    wide, long = u > 1.0, np.abs(v) > 1.0
+    return local[..., 0] / np.maximum(b[:, None, 3], 1e-9), local[..., 1] / np.maximum(b[:, None, 4], 1e-9)
+
+
+def regions(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n)`` index into :data:`REGIONS` of target ``j``'s centre in anchor ``i``'s frame (row: anchor)."""
+    u, v = _normalised(boxes)
+    wide, long = np.abs(u) > 1.0, np.abs(v) > 1.0
     out = np.where(wide & long, 4, np.where(wide, np.where(v >= 0, 2, 3), np.where(long, np.where(v > 0, 0, 1), 5)))
+    return out.astype(np.int8)
+
+
+def sides(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n)`` index into :data:`~pipeline.geometry.boxes.SIDES` (front, back, left, right) of the anchor side
+    target ``j``'s centre lies beyond (over the anchor's footprint, e.g. a chair tucked under a desk: the side it is
+    nearest in the anchor's scaled frame), -1 in a corner region and on the diagonal (row: anchor)."""
+    u, v = _normalised(boxes)
+    wide, long = np.abs(u) > 1.0, np.abs(v) > 1.0
+    long = np.where(wide | long, long, np.abs(v) >= np.abs(u))
+    out = np.where(wide & long, -1, np.where(long, np.where(v > 0, 0, 1), np.where(u < 0, 2, 3)))
+    np.fill_diagonal(out, -1)
     return out.astype(np.int8)
 
 

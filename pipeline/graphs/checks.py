@@ -2,8 +2,9 @@
 
 A graph is rejected when it is disconnected (an object not joined to the room), cyclic among objects (a directed
 cycle of object edges: refinement leaves real graphs acyclic), holds an edge type never seen between those two
-categories in training, or has an inconsistent chain (a chain member with no adjacent or proximal edge to another
-chain member; kitchen rows mix categories).
+categories in training, has an inconsistent chain (a chain member with no adjacent or proximal edge to another
+chain member; kitchen rows mix categories), or lacks a category (nearly) every training room holds
+(:func:`pipeline.room.contents.learn_contents`).
 """
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from .data import N_OBJECT_EDGES, OBJECT_EDGES, ROLES
 
 CHAIN_ROLES = {ROLES.index("chain"), ROLES.index("hub+chain")}
 NEAR = {k for k, name in enumerate(OBJECT_EDGES) if name.endswith(("adjacent", "proximal"))}
-REASONS = ("empty", "disconnected", "cyclic", "unseen_edge", "inconsistent_chain")
+REASONS = ("empty", "disconnected", "cyclic", "unseen_edge", "inconsistent_chain", "missing_required")
 
 
 def seen_triples(graphs) -> set[tuple[int, int, int]]:
@@ -27,8 +28,9 @@ def seen_triples(graphs) -> set[tuple[int, int, int]]:
 
 
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
-             seen: set[tuple[int, int, int]]) -> list[str]:
-    """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class)."""
+             seen: set[tuple[int, int, int]], required: set[int] = frozenset()) -> list[str]:
+    """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class); ``required``: node
+    classes every graph must hold."""
     out = [] if len(node_class) > n_arch else ["empty"]  # every real room holds an object
     n = len(node_class)
     undirected = nx.Graph()
@@ -44,6 +46,8 @@ def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int,
         out.append("unseen_edge")
     if not _chains_consistent(node_class, role, edges, n_arch):
         out.append("inconsistent_chain")
+    if not set(required) <= set(node_class[n_arch:]):
+        out.append("missing_required")
     return out
 
 

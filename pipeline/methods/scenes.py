@@ -1,8 +1,11 @@
 """Generated rooms as canonical tables (every stage reads them unchanged), one record per scene (failed ones
 included, with their reason), and per scene a GLB, a top-down PNG with the planned graph and a JSON summary: the one
-writer of every method's rooms."""
+writer of every method's rooms. The canonical tables hold the scored scenes only (placed, or partial with what they
+dropped named in their record): a failed scene's unfinished room is kept in its scene files alone, so no reader of
+the tables can take it for a room."""
 from __future__ import annotations
 
+import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,13 +30,16 @@ class Rows:
     objects: list[dict] = field(default_factory=list)
 
     def add(self, scene: Scene, corpus: Corpus, method: str) -> dict:
-        """Add one scene's rows (its room id is the scene id); returns its record."""
+        """Add one scene's record and, when it is scored, its canonical rows (its room id is the scene id); returns
+        its record."""
         room = scene.room
         record = {"scene_id": scene.scene_id, "room_type": corpus.room_type, "variant": method,
                   "source_room_id": scene.source_room_id, "status": scene.status, "reason": scene.reason,
                   "planned_objects": len(room.object_ids), "placed_objects": len(room.object_ids), **scene.record}
-        src = tables.records(corpus.rooms[corpus.rooms["room_id"] == scene.source_room_id])[0]
         self.records.append(record)
+        if scene.status not in SCORED:
+            return record
+        src = tables.records(corpus.rooms[corpus.rooms["room_id"] == scene.source_room_id])[0]
         self.rooms.append({**src, "room_id": scene.scene_id, "n_objects": len(room.object_ids), "shard": 0})
         arch = corpus.architecture[corpus.architecture["room_id"] == scene.source_room_id]
         self.architecture += tables.records(arch.assign(room_id=scene.scene_id))
@@ -88,7 +94,20 @@ def summarise(scenes: pd.DataFrame) -> dict:
             "violation": mean("violation"), "consistency": mean("consistency"),
             "collision_rate": _round(total("colliding_objects") / max(total("placed_objects"), 1), 4),
             "median_seconds": _round(scenes["seconds"].median(), 3),
-            "unplanned_adjacent_per_scene": _round(scenes["unplanned_adjacent"].mean(), 3)}
+            "unplanned_adjacent_per_scene": _round(scenes["unplanned_adjacent"].mean(), 3),
+            "plan_loss": plan_loss(scenes.loc[scored, "plan_loss"])}
+
+
+def plan_loss(rows: pd.Series) -> dict:
+    """Relation -> planned edges over the scenes' ``plan_loss`` JSON rows and each cause's share of them."""
+    total: dict = {}
+    for row in rows.dropna():
+        for relation, counts in json.loads(row).items():
+            acc = total.setdefault(relation, {})
+            for k, n in counts.items():
+                acc[k] = acc.get(k, 0) + n
+    return {r: {"planned": c["planned"], **{k: round(n / c["planned"], 4) for k, n in c.items() if k != "planned"}}
+            for r, c in sorted(total.items())}
 
 
 def _round(value, digits: int):

@@ -25,6 +25,7 @@ class Verdict:
     reason: str = ""
     cost: float = 0.0  # violation cost of the object's planned relations, in [0, 1]
     culprits: set[str] = field(default_factory=set)  # placed objects that caused the failure
+    edge_costs: list = field(default_factory=list)  # (PlanEdge, cost) of the object's planned relations
 
 
 def checks_config(config: dict) -> dict:
@@ -105,16 +106,16 @@ def blocks_door(room: RoomInput, corners: np.ndarray, depth: float) -> bool:
     return bool((overlap > AREA_EPS).any())
 
 
-def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str]]:
+def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str], list[float]]:
     """Mean cost of ``planned`` edges (each between the new object and a node already in the room) on the room's
-    extracted graph, and the objects at the other end of the edges not found exactly."""
+    extracted graph, the objects at the other end of the edges not found exactly, and each edge's cost."""
     if not planned:
-        return 0.0, set()
+        return 0.0, set(), []
     found = found_edges(checker.extract(room, anchors={e.source for e in planned}).edges)
     costs = [edge_cost(e, found) for e in planned]
     objects = set(room.object_ids)
     blame = {n for e, c in zip(planned, costs) if c > 0 for n in (e.source, e.target) if n in objects}
-    return float(np.mean(costs)), blame
+    return float(np.mean(costs)), blame, costs
 
 
 def check(room: RoomInput, k: int, parent: int | None, children: set[int], planned: list[PlanEdge],
@@ -134,8 +135,8 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
     hit = collision(room, k, children | ({parent} if parent is not None else set()), checker)
     if hit is not None:
         return Verdict(False, f"collides with {room.object_ids[hit[0]]} by {hit[1]:.3f} m", culprits={room.object_ids[hit[0]]})
-    cost, blame = relation_cost(room, planned, checker)
+    cost, blame, costs = relation_cost(room, planned, checker)
     blame.discard(me)
     if cost > tolerance or (cost >= 1.0 and planned):
         return Verdict(False, f"violates its relations (cost {cost:.2f})", cost, blame)
-    return Verdict(True, cost=cost)
+    return Verdict(True, cost=cost, edge_costs=list(zip(planned, costs)))

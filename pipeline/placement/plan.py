@@ -10,7 +10,7 @@ import pandas as pd
 DISTANCE_WEIGHT = {"adjacent": 3.0, "proximal": 2.0, "distant": 1.0}  # PlanIT's C_in weights; support counts as adjacent
 
 
-@dataclass
+@dataclass(frozen=True)
 class PlanEdge:
     source: str
     target: str

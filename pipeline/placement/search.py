@@ -5,7 +5,9 @@ floor or its support's top, minus squares around the points already rejected), a
 slides flush against the anchors it must be adjacent to, then must pass :func:`~pipeline.placement.checks.check`.
 After its sample budget, the search backtracks to the nearest earlier object that caused one of its failures (or
 the one before it) and that object is placed afresh elsewhere. The relation tolerance stays 0 for the first
-quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``. With ``early_backtrack``, an object at zero
+quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``; with ``keep_relations``, a candidate
+that breaks some of its relations within that tolerance is kept only when the object's remaining samples find none
+that keeps them all (the cheapest such candidate is taken). With ``early_backtrack``, an object at zero
 tolerance whose planned bands share no free cell backtracks at once instead of spending its samples. A scene fails, with its reason,
 when the backtrack or time budget runs out, or an object's category has no training instance; with
 ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search goes on.
@@ -30,6 +32,7 @@ from .checks import Checker, check
 from .layout import add_object, box_frame, wall_frame, with_objects
 from .order import chains
 from .plan import PlanEdge, ScenePlan
+from .poses import PoseRules
 from .proposers import RelationPrior
 from .retrieval import ModelPool, place
 
@@ -71,6 +74,7 @@ class Outcome:
     failures: dict = field(default_factory=dict)  # reason kind -> count
     dropped: list = field(default_factory=list)  # plan ids left out (on_exhausted: drop), in the order dropped
     attempts: int = 1  # searches from scratch (1 + restarts used)
+    accepted: dict = field(default_factory=dict)  # PlanEdge -> its cost when the later of its two ends was placed
 
     @property
     def status(self) -> str:
@@ -179,8 +183,8 @@ class Search:
     """One scene's search state."""
 
     def __init__(self, plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer,
-                 pool: ModelPool, checker: Checker, cfg: dict, rng: np.random.Generator):
-        self.plan, self.walls, self.order = plan, walls, order
+                 pool: ModelPool, checker: Checker, cfg: dict, rng: np.random.Generator, poses: PoseRules | None = None):
+        self.plan, self.walls, self.order, self.poses = plan, walls, order, poses
         self.proposer, self.pool, self.checker, self.cfg, self.rng = proposer, pool, checker, cfg, rng
         self.fixed = len(room.object_ids)  # objects given (completion) are never moved
         self.room = room
@@ -194,6 +198,7 @@ class Search:
         self.backtracks = self.rejections = self.insertions = 0
         self.failures: dict[str, int] = {}
         self.dropped: list[str] = []
+        self.accepted: dict = {}  # PlanEdge -> cost when its later end was last placed
         self.exhausted = False  # the backtrack budget ran out (the one failure a restart may cure)
         self._free = None  # the last free_floor: (room boxes and grow, cells)
 
@@ -269,6 +274,8 @@ class Search:
         xy = self.grid.points[cell] + self.rng.uniform(-0.5, 0.5, 2) * self.grid.mpp
         if yaw is None:
             yaw = self.proposer.orientation(self.room, self.walls, cat, sym, xy, self.rng)
+            if self.poses is not None:
+                yaw = self.poses.yaw(self.room, cat, anchors, xy, yaw)
         support = None if pk is None else float(self.room.boxes[pk, 2] + self.room.boxes[pk, 5])
         box, _ = place(inst, xy[0], xy[1], support, yaw)
         box = snap(box, anchors, self.room, self.gaps, self.cfg["snap"]["reach"])
@@ -289,6 +296,7 @@ class Search:
             log.debug("%s %s: no free cell in every planned band", self.plan.scene_id, v)
             self.failures["nowhere"] = self.failures.get("nowhere", 0) + 1
             return blocked
+        best = None  # with relaxed relations: the cheapest acceptable candidate so far (room, verdict)
         for _ in range(budget):
             cand = self.propose(k, half)
             if cand is None:
@@ -298,17 +306,25 @@ class Search:
             present = set(self.room.object_ids) | set(self.walls.ids)
             verdict = check(room, len(room.object_ids) - 1, None if pk is None else pk, set(),
                             planned_edges(v, self.plan, present), tol, self.checker)
+            if verdict.ok and (verdict.cost == 0 or not self.cfg["keep_relations"]):
+                return self.accept(room, verdict)
             if verdict.ok:
-                self.room = room
-                self.insertions += 1
-                return None
+                best = min(best or (room, verdict), (room, verdict), key=lambda rv: rv[1].cost)
+                continue
             self.rejections += 1
             log.debug("%s %s (%s) at %.2f, %.2f: %s", self.plan.scene_id, v, self.plan.categories[k], box[0], box[1], verdict.reason)
             kind = verdict.reason.split(" ")[0]
             self.failures[kind] = self.failures.get(kind, 0) + 1
             self.rejected.setdefault(v, []).append((float(xy[0]), float(xy[1])))
             culprits |= verdict.culprits
-        return culprits
+        return culprits if best is None else self.accept(*best)
+
+    def accept(self, room: RoomInput, verdict) -> None:
+        """Keep a candidate's room and the costs of its planned relations (the edges' loss records)."""
+        self.room = room
+        self.insertions += 1
+        self.accepted.update(verdict.edge_costs)
+        return None
 
     def run(self, deadline: float) -> str:
         """Place every object in order; '' on success, else why the scene failed."""
@@ -357,14 +373,15 @@ class Search:
 
 
 def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, pool: ModelPool,
-                checker: Checker, cfg: dict, seed: int) -> Outcome:
-    """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed). A search that
+                checker: Checker, cfg: dict, seed: int, poses: PoseRules | None = None) -> Outcome:
+    """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed); a floor
+    object's orientation follows the learned ``poses`` where one applies, else the proposer's. A search that
     spends its backtrack budget starts over, up to ``cfg['restarts']`` times: attempt ``a > 0`` draws from
     ``(seed, a)``, so the first attempt is the search without restarts. Counts and seconds add up over attempts."""
     start, runs = time.perf_counter(), []
     for attempt in range(cfg["restarts"] + 1):
         s = Search(plan, room, walls, order, proposer, pool, checker, cfg,
-                   np.random.default_rng(seed if attempt == 0 else [seed, attempt]))
+                   np.random.default_rng(seed if attempt == 0 else [seed, attempt]), poses)
         reason = s.run(time.perf_counter() + cfg["time_budget"])
         runs.append(s)
         if not s.exhausted:
@@ -376,4 +393,4 @@ def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int]
     total = lambda name: sum(getattr(r, name) for r in runs)
     failures = sum((Counter(r.failures) for r in runs), Counter())
     return Outcome(ok, s.room, reason, time.perf_counter() - start, total("insertions"), total("rejections"),
-                   total("backtracks"), dict(failures), s.dropped, len(runs))
+                   total("backtracks"), dict(failures), s.dropped, len(runs), s.accepted)

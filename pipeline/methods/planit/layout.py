@@ -22,6 +22,7 @@ from ...placement import order, proposers, scene_metrics
 from ...placement.checks import Checker, checks_config
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
+from ...placement.poses import PoseRules, describe, learn_pose_rules
 from ...placement.retrieval import ModelPool
 from ...placement.search import instantiate
 from ..interface import Corpus, Scene, Task
@@ -38,6 +39,7 @@ class Context:
     pool: ModelPool
     checker: Checker
     mean_area: dict
+    poses: PoseRules | None = None
 
 
 def load_context(config: dict, corpus: Corpus) -> Context:
@@ -50,7 +52,12 @@ def load_context(config: dict, corpus: Corpus) -> Context:
                       checks_config(config))
     objs = corpus.objects
     pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
-    return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))
+    rules = config["instantiate"]["pose_rules"]
+    poses = learn_pose_rules(corpus.training(), rules) if rules["enabled"] else None
+    if poses is not None:
+        log.info("%s: %d pose rules learned from %d training rooms:\n  %s", corpus.room_type,
+                 len(poses.turns), len(corpus.training()), "\n  ".join(describe(poses)))
+    return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])), poses)
 
 
 def make_proposer(location: str, saved, cfg: dict):
@@ -75,7 +82,7 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
     fixed = [plan.ids[k] for k in seq[:keep]]
     start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
     walls = walls_of(start)
-    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.pool, ctx.checker, cfg, seed), walls
+    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.pool, ctx.checker, cfg, seed, ctx.poses), walls
 
 
 def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
@@ -85,7 +92,7 @@ def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
     record = {"seconds": outcome.seconds, "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids),
               "insertions": outcome.insertions, "rejections": outcome.rejections, "backtracks": outcome.backtracks,
               "attempts": outcome.attempts, "failures": json.dumps(outcome.failures),
-              **scene_metrics.consistency(plan, room, walls.ids, ctx.checker, outcome.dropped),
+              **scene_metrics.consistency(plan, room, walls.ids, ctx.checker, outcome.dropped, outcome.accepted),
               "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
     return Scene(plan.scene_id, plan.room_id, room, walls, outcome.status, outcome.reason, record, plan.edges, parents)
 

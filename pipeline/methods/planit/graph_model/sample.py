@@ -8,6 +8,7 @@ import zlib
 from collections import Counter
 from pathlib import Path
 
+import numpy as np
 import torch
 
 from .... import tables
@@ -16,6 +17,7 @@ from ....graphs import checks as graph_checks
 from ....graphs import data as graph_data
 from ....graphs.data import ARCH
 from ....learning import checkpoint
+from ....room.contents import learn_contents
 from ....log import progress
 from . import train
 from .sampler import sample
@@ -49,6 +51,7 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     by_id = {g.room_id: g for g in graphs}
     held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
     seen = {tuple(t) for t in saved["seen"]}
+    caps, required = contents_of([g for g in graphs if g.room_id not in set(saved["heldout_ids"])], vocab, sc["contents"])
     plan = None
     if spec is not None:
         plan, arch_from = load_spec(spec, room_type, vocab)
@@ -60,7 +63,8 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
         raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
     n = count or sc["graphs"]
     base_seed = zlib.crc32(f"{config['seed']}/{room_type}/{Path(spec).name if spec else ''}".encode())
-    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, saved["max_edges"], room_type)
+    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, (seen, caps, required), plan, base_seed,
+                                             saved["max_edges"], room_type)
     rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"gen_{room_type}")
     summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": n - len(kept),
                "valid_before_rejection": round(first_try / max(n, 1), 4), "rejections": dict(reasons),
@@ -69,14 +73,27 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     return rows_n, rows_e, summary
 
 
+def contents_of(train: list, vocab, cfg: dict) -> tuple[np.ndarray | None, set[int]]:
+    """From the training graphs (``train``): each category's largest count in one room as ``(categories,)`` caps
+    (None when ``cfg['cap_counts']`` is off) and the node classes of the required categories
+    (:func:`pipeline.room.contents.learn_contents` with ``cfg['required_share']``; none when it is above 1)."""
+    names = [[vocab.node_classes[c] for c in g.node_class[g.n_arch:]] for g in train]
+    learned = learn_contents(names, cfg["required_share"]) if train else {"max_count": {}, "required": []}
+    cats = vocab.node_classes[len(ARCH):]
+    caps = np.array([learned["max_count"].get(c, 0) for c in cats]) if cfg["cap_counts"] and train else None
+    return caps, {vocab.node_classes.index(c) for c in learned["required"]} if cfg["required_share"] <= 1 else set()
+
+
 def _plan_triples(plan) -> set[tuple[int, int, int]]:
     cls = [len(ARCH) + c for c, _, _ in plan.objects]
     return {(cls[k], cls[j], c) if d == 0 else (cls[j], cls[k], c) for k, d, c, j in plan.edges}
 
 
-def _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, max_edges, room_type) -> tuple[dict, int, Counter]:
+def _sample_valid(net, vocab, held, n, sc, rules, plan, base_seed, max_edges, room_type) -> tuple[dict, int, Counter]:
     """Graph index -> (valid graph, seed); how many were valid at the first try; rejections by reason. A graph that
-    fails the checks is sampled again, up to ``resample_budget`` times."""
+    fails the checks is sampled again, up to ``resample_budget`` times. ``rules``: the seen edge triples, the count
+    caps and the required classes (:func:`contents_of`)."""
+    seen, caps, required = rules
     kept, first_try, reasons = {}, 0, Counter()
     pending = list(range(n))
     for attempt in range(sc["resample_budget"] + 1):
@@ -84,9 +101,9 @@ def _sample_valid(net, vocab, held, n, sc, seen, plan, base_seed, max_edges, roo
             part = pending[k:k + sc["batch_size"]]
             seed = base_seed + 1_000_003 * attempt + k
             grown = sample(net, vocab, [held[i % len(held)] for i in part], seed, sc["temperature"], sc["max_objects"],
-                           max_edges, [plan] * len(part) if plan else None, seen)
+                           max_edges, [plan] * len(part) if plan else None, seen, caps)
             for i, g in zip(part, grown):
-                bad = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen)
+                bad = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen, required)
                 reasons.update(bad)
                 first_try += attempt == 0 and not bad
                 if not bad:

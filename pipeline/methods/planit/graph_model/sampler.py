@@ -117,20 +117,28 @@ class _State:
 
 @torch.no_grad()
 def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, temperature: float, max_objects: int,
-           max_edges: int, plans: list[Plan] | None = None, seen: set | None = None) -> list[Grown]:
+           max_edges: int, plans: list[Plan] | None = None, seen: set | None = None,
+           caps: np.ndarray | None = None) -> list[Grown]:
     """One graph per architecture in ``archs`` (only their architecture is used), grown in one batch. With ``seen``
-    (anchor class, target class, type) triples, edges of unseen kinds are never proposed; edges that would close a
-    cycle among objects or give an object a second support parent never are, and every new object takes at least one
-    edge when it can (as in training, where each object touches a node before it)."""
+    (anchor class, target class, type) triples, edges of unseen kinds are never proposed; with ``caps``
+    ``(categories,)`` (each category's largest count in a training room), no category is chosen once a graph holds
+    that many (a plan's forced objects may exceed it); edges that would close a cycle among objects or give an object
+    a second support parent never are, and every new object takes at least one edge when it can (as in training,
+    where each object touches a node before it)."""
     gen = torch.Generator().manual_seed(int(seed))
     st = _State(model, archs, vocab, allowed_tensor(seen, len(vocab.node_classes)) if seen is not None else None)
     plans = plans or [Plan() for _ in archs]
     n_objects = [0] * len(archs)
+    counts = torch.zeros(len(archs), model.categories, dtype=torch.long)
+    limit = None if caps is None else torch.as_tensor(caps, dtype=torch.long)
     active = list(range(len(archs)))
     while active:
         act = torch.tensor(active)
         hg = st.propagate(act)
-        cats = _pick(model.add_node(hg[act]), temperature, gen).tolist()
+        logits = model.add_node(hg[act])
+        if limit is not None:
+            logits[:, :model.categories] = logits[:, :model.categories].masked_fill(counts[act] >= limit, float("-inf"))
+        cats = _pick(logits, temperature, gen).tolist()
         attrs = _pick(model.attributes(torch.cat([hg[act], F.one_hot(torch.tensor(cats).clamp(max=model.categories - 1),
                                                                       model.categories).float()], 1)), temperature, gen)
         adding = []
@@ -143,6 +151,7 @@ def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, tempe
                 continue
             st.add_node(b, len(ARCH) + cat, attr // len(ROLES), attr % len(ROLES))
             n_objects[b] += 1
+            counts[b, cat] += 1
             adding.append(b)
         active = adding
         if adding:

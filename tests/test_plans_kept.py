@@ -1,0 +1,100 @@
+"""Issue 28's pieces on hand-built cases: plausible contents learned from training rooms, pose rules learned from
+training rooms and applied to a candidate's orientation, the planned edges a placed room lost classified by cause,
+and failed scenes kept out of the canonical tables."""
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from conftest import default_config
+from test_functional import bedroom
+from pipeline.geometry.boxes import SIDES
+from pipeline.geometry.frames import Frame
+from pipeline.geometry.function import sides
+from pipeline.methods.interface import Scene
+from pipeline.methods.scenes import Rows, plan_loss
+from pipeline.placement import poses, scene_metrics
+from pipeline.placement.plan import PlanEdge
+from pipeline.placement.search import Anchor
+from pipeline.room.contents import implausible, learn_contents
+
+
+def test_contents_learned_from_training_rooms_flag_excess_and_missing_categories():
+    rooms = [["bed", "nightstand", "nightstand"]] * 30 + [["bed", "desk"]] * 2
+    learned = learn_contents(rooms, 0.75)  # 30 of 32 rooms: Wilson lower bound 0.80
+    assert learned["max_count"] == {"bed": 1, "desk": 1, "nightstand": 2} and learned["required"] == ["bed", "nightstand"]
+    assert implausible(["bed", "bed", "nightstand"], learned) == (["bed"], [])
+    assert implausible(["sofa", "nightstand"], learned) == (["sofa"], ["bed"])
+
+
+def test_sides_of_a_tucked_chair_a_flanking_nightstand_and_a_corner():
+    room = bedroom()
+    cats = room.categories
+    bed, ns, desk, chair = (cats.index(c) for c in ("bed", "nightstand", "desk", "chair"))
+    s = sides(room.boxes)
+    assert SIDES[s[desk, chair]] == "front"  # tucked in: over the desk's footprint, nearest its front
+    assert {SIDES[s[bed, ns]], SIDES[s[bed, ns + 1]]} == {"left", "right"}
+    corner = np.array([room.boxes[desk], [3.0, 1.0, 0.0, 0.1, 0.1, 0.1, 0.0]])  # beyond the desk's right-front corner
+    assert s[bed, bed] == -1 and sides(corner)[0, 1] == -1
+
+
+@pytest.fixture(scope="module")
+def rules():
+    cfg = {**default_config()["instantiate"]["pose_rules"], "min_share": 0.85}
+    train = [bedroom(dx, room_id=f"t{k}") for k, dx in enumerate(np.linspace(-0.6, 0.6, 25))]
+    return poses.learn_pose_rules(train, cfg)
+
+
+def test_pose_rules_are_learned_from_the_training_rooms(rules):
+    assert rules.turns[("desk", "chair", SIDES.index("front"))] == 2  # faces its desk
+    assert rules.turns[("bed", "nightstand", SIDES.index("left"))] == 0  # turns with the bed
+    assert ("desk", "chair", SIDES.index("left")) not in rules.turns  # never seen there
+
+
+def test_a_chair_in_front_of_its_desk_is_turned_to_face_it_whatever_the_network_proposed(rules):
+    base = bedroom(chair_yaw=0.0)
+    desk = base.categories.index("desk")
+    for yaw in (0.0, np.pi / 2):  # the desk turned: the rule is in the desk's frame
+        boxes = base.boxes.copy()
+        boxes[desk, 6] = yaw
+        room = replace(base, boxes=boxes)
+        anchor = Anchor("desk", Frame(tuple(room.boxes[desk, :2]), yaw), "none", "front", "adjacent", obj=desk)
+        front = room.boxes[desk, :2] + 0.6 * np.array([-np.sin(yaw), np.cos(yaw)])
+        got = rules.yaw(room, "chair", [anchor], front, proposed=1.0)
+        assert np.cos(got - (yaw + np.pi)) == pytest.approx(1.0)
+        beside = room.boxes[desk, :2] + 1.0 * np.array([np.cos(yaw), np.sin(yaw)])
+        assert rules.yaw(room, "chair", [anchor], beside, proposed=1.0) == 1.0  # no rule there: the proposal
+
+
+def test_lost_plan_edges_are_classified_by_when_and_what_extraction_found():
+    e = lambda s, t, d, x: PlanEdge(s, t, "spatial", d, x)  # noqa: E731
+    kept, relaxed, later, gone = e("a", "b", "front", "adjacent"), e("a", "c", "left", "adjacent"), \
+        e("b", "c", "front", "proximal"), e("a", "d", "back", "distant")
+    support = PlanEdge("a", "b", "support", None, None)
+    found = {("a", "b"): [("spatial", "front", "adjacent")], ("a", "c"): [("spatial", "left", "proximal")],
+             ("b", "c"): [("spatial", "back", "proximal")]}
+    accepted = {kept: 0.0, relaxed: 0.5, later: 0.0, support: 0.0}
+    planned = [kept, relaxed, later, gone, support]
+    costs = np.array([1.0 if p is support else 0.0 if p is kept else 0.5 if p is relaxed else 1.0 for p in planned])
+    loss = scene_metrics.plan_loss(planned, costs, found, {"d"}, accepted)
+    assert loss["adjacent"] == {"planned": 2, "relaxed": 1, "distance": 1}
+    assert loss["proximal"] == {"planned": 1, "lost_later": 1, "direction": 1}
+    assert loss["distant"] == {"planned": 1, "unplaced": 1, "absent": 1}
+    assert loss["support"] == {"planned": 1, "lost_later": 1, "absent": 1}
+    shares = plan_loss(__import__("pandas").Series([json.dumps(loss), json.dumps(loss), None]))
+    assert shares["adjacent"] == {"planned": 4, "relaxed": 0.5, "distance": 0.5}
+
+
+def test_a_failed_scene_is_recorded_but_its_unfinished_room_stays_out_of_the_canonical_tables():
+    room = bedroom()
+
+    class Corpus:
+        room_type = "bedroom"
+
+    rows = Rows()
+    record = rows.add(Scene("s0", "r0", room, None, "failed", "backtrack budget spent"), Corpus(), "planit")
+    assert record["status"] == "failed" and record["placed_objects"] == len(room.object_ids)
+    assert rows.records == [record] and rows.objects == [] and rows.rooms == [] and rows.architecture == []
