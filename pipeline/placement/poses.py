@@ -30,10 +30,10 @@ class PoseRules:
     anchor's."""
     turns: dict = field(default_factory=dict)
 
-    def yaw(self, room: RoomInput, category: str, anchors: list, xy: np.ndarray, proposed: float) -> float:
-        """The yaw (rad) of an object of ``category`` centred at ``xy (2,)`` whose proposer gave ``proposed``: the
-        first object anchor's rule (:class:`~pipeline.placement.search.Anchor`, the nearest planned distance first),
-        else ``proposed``."""
+    def yaw(self, room: RoomInput, category: str, anchors: list, xy: np.ndarray) -> float | None:
+        """The yaw (rad) the rules give an object of ``category`` centred at ``xy (2,)``: its first object anchor's
+        rule (:class:`~pipeline.placement.search.Anchor`, the nearest planned distance first); None when no rule
+        applies."""
         for a in sorted(anchors, key=lambda a: DISTANCES.index(a.distance) if a.distance in DISTANCES else 3):
             if a.obj is None:
                 continue
@@ -42,7 +42,7 @@ class PoseRules:
             turn = self.turns.get((room.categories[a.obj], category, side))
             if turn is not None:
                 return float(box[6] + turn * QUARTER)
-        return proposed
+        return None
 
 
 def quarter_turns(rel: np.ndarray, max_error: float) -> np.ndarray:

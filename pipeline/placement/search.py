@@ -272,10 +272,10 @@ class Search:
             p = mask.astype(float)
         cell = self.rng.choice(len(p), p=p / p.sum())
         xy = self.grid.points[cell] + self.rng.uniform(-0.5, 0.5, 2) * self.grid.mpp
+        if yaw is None and self.poses is not None:  # a learned rule first: no network call where one applies
+            yaw = self.poses.yaw(self.room, cat, anchors, xy)
         if yaw is None:
             yaw = self.proposer.orientation(self.room, self.walls, cat, sym, xy, self.rng)
-            if self.poses is not None:
-                yaw = self.poses.yaw(self.room, cat, anchors, xy, yaw)
         support = None if pk is None else float(self.room.boxes[pk, 2] + self.room.boxes[pk, 5])
         box, _ = place(inst, xy[0], xy[1], support, yaw)
         box = snap(box, anchors, self.room, self.gaps, self.cfg["snap"]["reach"])
