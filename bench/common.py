@@ -22,19 +22,21 @@ def arguments(doc: str, workdir: Path = OUT) -> argparse.ArgumentParser:
 
 
 def search_flags(ap: argparse.ArgumentParser) -> None:
-    """``--[no-]early-backtrack``, ``--restarts N``, ``--[no-]pose-rules`` and ``--[no-]keep-relations``: the search
-    settings a bench may set (default: the config's)."""
+    """``--[no-]early-backtrack``, ``--restarts N``, ``--[no-]pose-rules``, ``--[no-]keep-relations`` and
+    ``--[no-]relations-first``: the search settings a bench may set (default: the config's)."""
     ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
     ap.add_argument("--restarts", type=int)
     ap.add_argument("--pose-rules", action=argparse.BooleanOptionalAction)
     ap.add_argument("--keep-relations", action=argparse.BooleanOptionalAction)
+    ap.add_argument("--relations-first", action=argparse.BooleanOptionalAction)
 
 
 def search_overrides(args) -> dict:
     """The ``instantiate`` keys :func:`search_flags` set on the command line."""
     out = {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts),
                              ("keep_relations", args.keep_relations)) if v is not None}
-    return out | ({} if args.pose_rules is None else {"pose_rules": {**POSE_RULES, "enabled": args.pose_rules}})
+    out |= {} if args.pose_rules is None else {"pose_rules": {**POSE_RULES, "enabled": args.pose_rules}}
+    return out | ({} if args.relations_first is None else {"checks": {**CHECKS, "relations_first": args.relations_first}})
 
 
 def search_suffix(args) -> str:
@@ -42,10 +44,12 @@ def search_suffix(args) -> str:
     return ({True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
             + (f"_restarts{args.restarts}" if args.restarts is not None else "")
             + {True: "_pose_rules", False: "_no_pose_rules", None: ""}[args.pose_rules]
-            + {True: "_keep_relations", False: "_no_keep_relations", None: ""}[args.keep_relations])
+            + {True: "_keep_relations", False: "_no_keep_relations", None: ""}[args.keep_relations]
+            + {True: "_relations_first", False: "_collisions_first", None: ""}[args.relations_first])
 
 
 POSE_RULES = config_mod.load(ROOT / "config" / "config.yaml")["instantiate"]["pose_rules"]
+CHECKS = config_mod.load(ROOT / "config" / "config.yaml")["instantiate"]["checks"]
 
 
 def default_config() -> dict:

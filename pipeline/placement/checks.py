@@ -30,8 +30,10 @@ class Verdict:
 
 def checks_config(config: dict) -> dict:
     """The ``instantiate.checks`` thresholds with the evaluation's penetration measure as ``confirm``: a pair the
-    coarse per-attempt grid clears is measured again the way the evaluation measures it."""
-    return {**config["instantiate"]["checks"], "confirm": config["evaluate"]["collision"]["penetration"]}
+    coarse per-attempt grid clears is measured again the way the evaluation measures it (no second measure when the
+    per-attempt measure is the evaluation's)."""
+    own, evaluation = config["instantiate"]["checks"], config["evaluate"]["collision"]["penetration"]
+    return {**own, "confirm": None if own["penetration"] == evaluation else evaluation}
 
 
 @dataclass
@@ -120,8 +122,9 @@ def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) ->
 
 def check(room: RoomInput, k: int, parent: int | None, children: set[int], planned: list[PlanEdge],
           tolerance: float, checker: Checker) -> Verdict:
-    """Verdict on object ``k`` of ``room`` (cheap tests first). ``tolerance``: the violation cost allowed now; an
-    object may never break all of its relations fully."""
+    """Verdict on object ``k`` of ``room`` (cheap tests first; the mesh collision test after the relations when
+    ``checks.relations_first``: most candidates break a relation, and the mesh test is the dearer). ``tolerance``: the
+    violation cost allowed now; an object may never break all of its relations fully."""
     me = room.object_ids[k]
     corners = boxes.footprint_corners(*room.boxes[k, [0, 1, 3, 4, 6]])[0]
     if parent is None:
@@ -132,11 +135,21 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
             return Verdict(False, "blocks a door's clearance")
     elif support_share(room.boxes[k], room.boxes[parent]) < checker.cfg["min_support"]:
         return Verdict(False, "overhangs its support", culprits={room.object_ids[parent]})
-    hit = collision(room, k, children | ({parent} if parent is not None else set()), checker)
-    if hit is not None:
-        return Verdict(False, f"collides with {room.object_ids[hit[0]]} by {hit[1]:.3f} m", culprits={room.object_ids[hit[0]]})
+    related = children | ({parent} if parent is not None else set())
+    if not checker.cfg["relations_first"]:
+        hit = collision(room, k, related, checker)
+        if hit is not None:
+            return collides(room, hit)
     cost, blame, costs = relation_cost(room, planned, checker)
     blame.discard(me)
     if cost > tolerance or (cost >= 1.0 and planned):
         return Verdict(False, f"violates its relations (cost {cost:.2f})", cost, blame)
+    if checker.cfg["relations_first"]:
+        hit = collision(room, k, related, checker)
+        if hit is not None:
+            return collides(room, hit)
     return Verdict(True, cost=cost, edge_costs=list(zip(planned, costs)))
+
+
+def collides(room: RoomInput, hit: tuple[int, float]) -> Verdict:
+    return Verdict(False, f"collides with {room.object_ids[hit[0]]} by {hit[1]:.3f} m", culprits={room.object_ids[hit[0]]})
