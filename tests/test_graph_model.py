@@ -268,8 +268,9 @@ def test_count_caps_and_required_categories_keep_sampled_contents_plausible(bedr
     repeats = lambda gs: sum(len(g.node_class[g.arch.n_arch:]) != len(set(g.node_class[g.arch.n_arch:])) for g in gs)  # noqa: E731
     free = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0, max_objects=25, max_edges=10)
     capped = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0, max_objects=25, max_edges=10,
-                            caps=np.ones(cats, int))
+                            caps=np.ones(cats, int), opposite_ok=set())
     assert repeats(free) > 0 and repeats(capped) == 0
+    assert not any(graph_checks.near_opposite_walls(g.node_class, g.edges) for g in capped)
     g = capped[0]
     absent = next(c for c in range(n_arch, len(vocab.node_classes)) if c not in g.node_class)
     assert "missing_required" in graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch,

@@ -4,17 +4,21 @@ A graph is rejected when it is disconnected (an object not joined to the room), 
 cycle of object edges: refinement leaves real graphs acyclic), holds an edge type never seen between those two
 categories in training, has an inconsistent chain (a chain member with no adjacent or proximal edge to another
 chain member; kitchen rows mix categories), or lacks a category (nearly) every training room holds
-(:func:`pipeline.room.contents.learn_contents`).
+(:func:`pipeline.room.contents.learn_contents`), or puts an object adjacent or proximal to two opposite walls
+(:func:`near_opposite_walls`: no real graph of the AI2-THOR rooms does, 5 of 10,000 objects of the procedural ones;
+the categories the training graphs show doing it are allowed).
 """
 from __future__ import annotations
 
 import networkx as nx
 
-from .data import N_OBJECT_EDGES, OBJECT_EDGES, ROLES
+from .data import EDGE_CLASSES, N_OBJECT_EDGES, OBJECT_EDGES, ROLES
 
 CHAIN_ROLES = {ROLES.index("chain"), ROLES.index("hub+chain")}
 NEAR = {k for k, name in enumerate(OBJECT_EDGES) if name.endswith(("adjacent", "proximal"))}
-REASONS = ("empty", "disconnected", "cyclic", "unseen_edge", "inconsistent_chain", "missing_required")
+OPPOSITE = EDGE_CLASSES.index("wall_opposite")
+REASONS = ("empty", "disconnected", "cyclic", "unseen_edge", "inconsistent_chain", "missing_required",
+           "near_opposite_walls")
 
 
 def seen_triples(graphs) -> set[tuple[int, int, int]]:
@@ -28,9 +32,10 @@ def seen_triples(graphs) -> set[tuple[int, int, int]]:
 
 
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
-             seen: set[tuple[int, int, int]], required: set[int] = frozenset()) -> list[str]:
+             seen: set[tuple[int, int, int]], required: set[int] = frozenset(),
+             opposite_ok: set[int] = frozenset()) -> list[str]:
     """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class); ``required``: node
-    classes every graph must hold."""
+    classes every graph must hold; ``opposite_ok``: node classes that may stand near two opposite walls."""
     out = [] if len(node_class) > n_arch else ["empty"]  # every real room holds an object
     n = len(node_class)
     undirected = nx.Graph()
@@ -48,7 +53,25 @@ def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int,
         out.append("inconsistent_chain")
     if not set(required) <= set(node_class[n_arch:]):
         out.append("missing_required")
+    if any(node_class[k] not in opposite_ok for k in near_opposite_walls(node_class, edges)):
+        out.append("near_opposite_walls")
     return out
+
+
+def near_walls(node_class: list[int], edges: list[tuple[int, int, int]]) -> dict[int, set[int]]:
+    """Object -> the walls (node class 0) with an adjacent or proximal edge to it."""
+    out: dict[int, set[int]] = {}
+    for s, t, c in edges:
+        if c in NEAR and node_class[s] == 0:
+            out.setdefault(t, set()).add(s)
+    return out
+
+
+def near_opposite_walls(node_class: list[int], edges: list[tuple[int, int, int]]) -> list[int]:
+    """The objects with adjacent or proximal edges from two walls that the architecture calls opposite."""
+    opposite = {(s, t) for s, t, c in edges if c == OPPOSITE} | {(t, s) for s, t, c in edges if c == OPPOSITE}
+    return sorted(k for k, ws in near_walls(node_class, edges).items()
+                  if any((a, b) in opposite for a in ws for b in ws if a != b))
 
 
 def _chains_consistent(node_class, role, edges, n_arch) -> bool:

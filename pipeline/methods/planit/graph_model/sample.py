@@ -51,7 +51,10 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     by_id = {g.room_id: g for g in graphs}
     held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
     seen = {tuple(t) for t in saved["seen"]}
-    caps, required = contents_of([g for g in graphs if g.room_id not in set(saved["heldout_ids"])], vocab, sc["contents"])
+    train_graphs = [g for g in graphs if g.room_id not in set(saved["heldout_ids"])]
+    caps, required = contents_of(train_graphs, vocab, sc["contents"])
+    opposite_ok = {int(g.node_class[k]) for g in train_graphs
+                   for k in graph_checks.near_opposite_walls(g.node_class.tolist(), [tuple(e) for e in g.edges.tolist()])}
     plan = None
     if spec is not None:
         plan, arch_from = load_spec(spec, room_type, vocab)
@@ -63,7 +66,7 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
         raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
     n = count or sc["graphs"]
     base_seed = zlib.crc32(f"{config['seed']}/{room_type}/{Path(spec).name if spec else ''}".encode())
-    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, (seen, caps, required), plan, base_seed,
+    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, (seen, caps, required, opposite_ok), plan, base_seed,
                                              saved["max_edges"], room_type)
     rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"gen_{room_type}")
     summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": n - len(kept),
@@ -92,8 +95,9 @@ def _plan_triples(plan) -> set[tuple[int, int, int]]:
 def _sample_valid(net, vocab, held, n, sc, rules, plan, base_seed, max_edges, room_type) -> tuple[dict, int, Counter]:
     """Graph index -> (valid graph, seed); how many were valid at the first try; rejections by reason. A graph that
     fails the checks is sampled again, up to ``resample_budget`` times. ``rules``: the seen edge triples, the count
-    caps and the required classes (:func:`contents_of`)."""
-    seen, caps, required = rules
+    caps and the required classes (:func:`contents_of`), and the classes the training graphs show near two opposite
+    walls."""
+    seen, caps, required, opposite_ok = rules
     kept, first_try, reasons = {}, 0, Counter()
     pending = list(range(n))
     for attempt in range(sc["resample_budget"] + 1):
@@ -101,9 +105,9 @@ def _sample_valid(net, vocab, held, n, sc, rules, plan, base_seed, max_edges, ro
             part = pending[k:k + sc["batch_size"]]
             seed = base_seed + 1_000_003 * attempt + k
             grown = sample(net, vocab, [held[i % len(held)] for i in part], seed, sc["temperature"], sc["max_objects"],
-                           max_edges, [plan] * len(part) if plan else None, seen, caps)
+                           max_edges, [plan] * len(part) if plan else None, seen, caps, opposite_ok)
             for i, g in zip(part, grown):
-                bad = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen, required)
+                bad = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen, required, opposite_ok)
                 reasons.update(bad)
                 first_try += attempt == 0 and not bad
                 if not bad:

@@ -14,6 +14,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
+from ....graphs import checks as graph_checks
 from ....graphs.data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, features, node_features
 from .model import EDGE_CHOICES, GraphModel
 from .teacher import candidate_logits, edge_features
@@ -64,6 +65,7 @@ class _State:
 
     def __init__(self, model: GraphModel, archs: list[Graph], vocab: Vocab, allowed: torch.Tensor | None = None):
         self.model, self.vocab, self.allowed = model, vocab, allowed
+        self.opposite_ok: set | None = None  # node classes that may stand near two opposite walls (None: any)
         self.grown = [Grown(g, g.node_class[:g.n_arch].tolist(), g.symmetry[:g.n_arch].tolist(),
                             g.role[:g.n_arch].tolist(), []) for g in archs]
         xs = [torch.as_tensor(node_features(g, vocab)[:g.n_arch]) for g in archs]
@@ -118,15 +120,17 @@ class _State:
 @torch.no_grad()
 def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, temperature: float, max_objects: int,
            max_edges: int, plans: list[Plan] | None = None, seen: set | None = None,
-           caps: np.ndarray | None = None) -> list[Grown]:
+           caps: np.ndarray | None = None, opposite_ok: set | None = None) -> list[Grown]:
     """One graph per architecture in ``archs`` (only their architecture is used), grown in one batch. With ``seen``
     (anchor class, target class, type) triples, edges of unseen kinds are never proposed; with ``caps``
     ``(categories,)`` (each category's largest count in a training room), no category is chosen once a graph holds
     that many (a plan's forced objects may exceed it); edges that would close a cycle among objects or give an object
-    a second support parent never are, and every new object takes at least one edge when it can (as in training,
-    where each object touches a node before it)."""
+    a second support parent never are; with ``opposite_ok`` (node classes), no object outside it is put adjacent or
+    proximal to two opposite walls; and every new object takes at least one edge when it can (as in training, where
+    each object touches a node before it)."""
     gen = torch.Generator().manual_seed(int(seed))
     st = _State(model, archs, vocab, allowed_tensor(seen, len(vocab.node_classes)) if seen is not None else None)
+    st.opposite_ok = opposite_ok
     plans = plans or [Plan() for _ in archs]
     n_objects = [0] * len(archs)
     counts = torch.zeros(len(archs), model.categories, dtype=torch.long)
@@ -246,4 +250,13 @@ def _order_mask(st: _State, graphs, width) -> torch.Tensor:
         for u in has_parent:
             if u < width:
                 mask[r, u, 1, 0] = True
+        if st.opposite_ok is not None and g.node_class[me] not in st.opposite_ok:
+            for u in _opposite_of_near(g, me):
+                mask[r, u, 0, sorted(graph_checks.NEAR)] = True
     return mask.reshape(len(graphs), width, EDGE_CHOICES)
+
+
+def _opposite_of_near(g: Grown, me: int) -> set[int]:
+    """The walls opposite a wall that already has an adjacent or proximal edge to object ``me``."""
+    near = graph_checks.near_walls(g.node_class, g.edges).get(me, set())
+    return {t if s in near else s for s, t, c in g.edges if c == graph_checks.OPPOSITE and (s in near or t in near)}
