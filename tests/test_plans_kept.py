@@ -111,3 +111,15 @@ def test_an_object_near_two_opposite_walls_is_an_invalid_plan_unless_training_gr
     assert "near_opposite_walls" not in problems([(0, 4, near), (1, 4, near)])  # a corner
     assert "near_opposite_walls" not in problems([(0, 4, near), (2, 4, far)])  # across the room: far from one
     assert "near_opposite_walls" not in problems([(0, 4, near), (2, 4, near)], {7})  # the training rooms do it
+
+
+def test_a_floor_node_with_planned_spatial_edges_takes_an_instance_that_stood_on_the_floor():
+    import pandas as pd
+    from pipeline.placement.retrieval import ModelPool
+    row = lambda model, z, hz: {"category": "counter_top", "model_id": model, "cx": 0.0, "cy": 0.0, "cz": z, "hx": 0.5,  # noqa: E731
+                                "hy": 0.3, "hz": hz, "yaw": 0.0, "px": 0.0, "py": 0.0, "pz": z - hz, "sx": 1.0,
+                                "sy": 1.0, "sz": 1.0}
+    pool = ModelPool(pd.DataFrame([row("slab", 0.93, 0.01), row("cabinet", 0.45, 0.45)] * 3), {}, 0.04)
+    rng = np.random.default_rng(0)
+    assert {pool.pick("counter_top", "none", rng, grounded=True).model_id for _ in range(20)} == {"cabinet"}
+    assert {pool.pick("counter_top", "none", rng).model_id for _ in range(40)} == {"slab", "cabinet"}

@@ -43,13 +43,17 @@ class ModelPool:
     def has(self, category: str) -> bool:
         return category in self.by_cat
 
-    def pick(self, category: str, symmetry: str, rng: np.random.Generator) -> Instance:
-        """A random instance of the category, of the node's symmetry where the category has one."""
+    def pick(self, category: str, symmetry: str, rng: np.random.Generator, grounded: bool = False) -> Instance:
+        """A random instance of the category, of the node's symmetry where the category has one; ``grounded``: one
+        that stood on the floor where the category has such (a floor node with planned spatial edges: extraction
+        sees no spatial relation of an object hanging above the floor, e.g. an AI2-THOR counter-top slab)."""
         if category not in self.by_cat:
             raise KeyError(f"no training instance of category '{category}'")
         pool = self.by_cat[category]
-        same = [k for k, s in enumerate(self.sym[category]) if s == symmetry]
-        return pool[int(rng.choice(same))] if same else pool[int(rng.integers(len(pool)))]
+        keep = [k for k, inst in enumerate(pool) if inst.lift == 0.0] if grounded else []
+        keep = keep or list(range(len(pool)))
+        same = [k for k in keep if self.sym[category][k] == symmetry]
+        return pool[int(rng.choice(same or keep))]
 
 
 def place(inst: Instance, x: float, y: float, support: float | None, yaw: float) -> tuple[np.ndarray, np.ndarray]:

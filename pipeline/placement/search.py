@@ -203,7 +203,8 @@ class Search:
         self._free = None  # the last free_floor: (room boxes and grow, cells)
 
     def model_for(self, k: int):
-        """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's."""
+        """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's; a floor node
+        with planned spatial edges takes one that stood on the floor (:meth:`ModelPool.pick`)."""
         cat, key = self.plan.categories[k], ("own", k)
         if self.plan.role[k] == "spoke":
             hubs = [e.source for e in self.plan.edges if e.target == self.plan.ids[k] and e.source in self.plan.ids
@@ -212,7 +213,10 @@ class Search:
         elif k in self.unit:
             key = ("chain", self.unit[k], cat)
         if key not in self.shared:
-            self.shared[key] = self.pool.pick(cat, self.plan.symmetry[k], self.rng)
+            v = self.plan.ids[k]
+            grounded = self.plan.parent[k] is None and any(
+                e.edge_type == "spatial" and v in (e.source, e.target) for e in self.plan.edges)
+            self.shared[key] = self.pool.pick(cat, self.plan.symmetry[k], self.rng, grounded)
         return self.shared[key]
 
     def occupied(self, grow: float) -> np.ndarray:
