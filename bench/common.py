@@ -32,11 +32,12 @@ def search_flags(ap: argparse.ArgumentParser) -> None:
 
 
 def search_overrides(args) -> dict:
-    """The ``instantiate`` keys :func:`search_flags` set on the command line."""
+    """The ``instantiate`` keys :func:`search_flags` set on the command line (nested sections partly: merge them with
+    :func:`pipeline.config.deep_merge`)."""
     out = {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts),
                              ("keep_relations", args.keep_relations)) if v is not None}
-    out |= {} if args.pose_rules is None else {"pose_rules": {**POSE_RULES, "enabled": args.pose_rules}}
-    return out | ({} if args.relations_first is None else {"checks": {**CHECKS, "relations_first": args.relations_first}})
+    out |= {} if args.pose_rules is None else {"pose_rules": {"enabled": args.pose_rules}}
+    return out | ({} if args.relations_first is None else {"checks": {"relations_first": args.relations_first}})
 
 
 def search_suffix(args) -> str:
@@ -46,10 +47,6 @@ def search_suffix(args) -> str:
             + {True: "_pose_rules", False: "_no_pose_rules", None: ""}[args.pose_rules]
             + {True: "_keep_relations", False: "_no_keep_relations", None: ""}[args.keep_relations]
             + {True: "_relations_first", False: "_collisions_first", None: ""}[args.relations_first])
-
-
-POSE_RULES = config_mod.load(ROOT / "config" / "config.yaml")["instantiate"]["pose_rules"]
-CHECKS = config_mod.load(ROOT / "config" / "config.yaml")["instantiate"]["checks"]
 
 
 def default_config() -> dict:

@@ -109,7 +109,7 @@ def main() -> None:
     args = ap.parse_args()
     torch.set_num_threads(1)
     cfg = config_mod.load(ROOT / "config" / "config.yaml")
-    cfg["instantiate"].update(search_overrides(args))
+    cfg["instantiate"] = config_mod.deep_merge(cfg["instantiate"], search_overrides(args))
     if args.density_cache:
         cfg["instantiate"]["density_cache"] = args.density_cache
     saved = checkpoint.load(ROOT / "results/placement" / args.room_type / "cfcn" / "model.pt", "placement_nets")

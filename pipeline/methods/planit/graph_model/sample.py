@@ -51,7 +51,8 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     by_id = {g.room_id: g for g in graphs}
     held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
     seen = {tuple(t) for t in saved["seen"]}
-    train_graphs = [g for g in graphs if g.room_id not in set(saved["heldout_ids"])]
+    heldout_ids = set(saved["heldout_ids"])
+    train_graphs = [g for g in graphs if g.room_id not in heldout_ids]
     caps, required = contents_of(train_graphs, vocab, sc["contents"])
     opposite_ok = {int(g.node_class[k]) for g in train_graphs
                    for k in graph_checks.near_opposite_walls(g.node_class.tolist(), [tuple(e) for e in g.edges.tolist()])}
@@ -78,13 +79,14 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
 
 def contents_of(train: list, vocab, cfg: dict) -> tuple[np.ndarray | None, set[int]]:
     """From the training graphs (``train``): each category's largest count in one room as ``(categories,)`` caps
-    (None when ``cfg['cap_counts']`` is off) and the node classes of the required categories
-    (:func:`pipeline.room.contents.learn_contents` with ``cfg['required_share']``; none when it is above 1)."""
-    names = [[vocab.node_classes[c] for c in g.node_class[g.n_arch:]] for g in train]
-    learned = learn_contents(names, cfg["required_share"]) if train else {"max_count": {}, "required": []}
+    (None when ``cfg['cap_counts']`` is off, or without training graphs) and the node classes of the required
+    categories (:func:`pipeline.room.contents.learn_contents` with ``cfg['required_share']``: none above 1, which no
+    Wilson bound reaches)."""
+    learned = learn_contents([[vocab.node_classes[c] for c in g.node_class[g.n_arch:]] for g in train],
+                             cfg["required_share"])
     cats = vocab.node_classes[len(ARCH):]
     caps = np.array([learned["max_count"].get(c, 0) for c in cats]) if cfg["cap_counts"] and train else None
-    return caps, {vocab.node_classes.index(c) for c in learned["required"]} if cfg["required_share"] <= 1 else set()
+    return caps, {vocab.node_classes.index(c) for c in learned["required"]}
 
 
 def _plan_triples(plan) -> set[tuple[int, int, int]]:

@@ -63,9 +63,10 @@ def _pick(logits: torch.Tensor, temperature: float, gen: torch.Generator) -> tor
 class _State:
     """Growing node and edge tensors of the graphs being sampled (nodes of all graphs interleaved)."""
 
-    def __init__(self, model: GraphModel, archs: list[Graph], vocab: Vocab, allowed: torch.Tensor | None = None):
+    def __init__(self, model: GraphModel, archs: list[Graph], vocab: Vocab, allowed: torch.Tensor | None = None,
+                 opposite_ok: set | None = None):
         self.model, self.vocab, self.allowed = model, vocab, allowed
-        self.opposite_ok: set | None = None  # node classes that may stand near two opposite walls (None: any)
+        self.opposite_ok = opposite_ok  # node classes that may stand near two opposite walls (None: any)
         self.grown = [Grown(g, g.node_class[:g.n_arch].tolist(), g.symmetry[:g.n_arch].tolist(),
                             g.role[:g.n_arch].tolist(), []) for g in archs]
         xs = [torch.as_tensor(node_features(g, vocab)[:g.n_arch]) for g in archs]
@@ -129,8 +130,8 @@ def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, tempe
     proximal to two opposite walls; and every new object takes at least one edge when it can (as in training, where
     each object touches a node before it)."""
     gen = torch.Generator().manual_seed(int(seed))
-    st = _State(model, archs, vocab, allowed_tensor(seen, len(vocab.node_classes)) if seen is not None else None)
-    st.opposite_ok = opposite_ok
+    st = _State(model, archs, vocab, allowed_tensor(seen, len(vocab.node_classes)) if seen is not None else None,
+                opposite_ok)
     plans = plans or [Plan() for _ in archs]
     n_objects = [0] * len(archs)
     counts = torch.zeros(len(archs), model.categories, dtype=torch.long)
