@@ -26,3 +26,6 @@ rule all:
         learned_outputs,
         RUNTIME,
     default_target: True
+
+
+refuse_folders(workflow.rules)

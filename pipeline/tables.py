@@ -6,11 +6,14 @@ counter-clockwise about +Z.
 """
 from __future__ import annotations
 
+import io
 import json
 import os
 import tempfile
+import zipfile
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Iterator
 
 import pyarrow as pa
 import pyarrow.compute as pc
@@ -398,19 +401,62 @@ def write_parts(path: str | Path, name: str, parts, extra: dict | None = None) -
     return rows
 
 
-def _atomic(path: Path, write_to) -> Path:
-    """Call ``write_to(temporary path)`` in ``path``'s folder, then rename onto ``path``; nothing is left on failure."""
+@contextmanager
+def _temporary(path: Path) -> Iterator[str]:
+    """A temporary path in ``path``'s folder, renamed onto ``path`` when the block ends; nothing is left on failure."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
-        write_to(tmp)
+        yield tmp
         os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; shared (cluster) filesystems need the usual mode
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _atomic(path: Path, write_to) -> Path:
+    """Call ``write_to(temporary path)`` in ``path``'s folder, then rename onto ``path``; nothing is left on failure."""
+    with _temporary(path) as tmp:
+        write_to(tmp)
     return path
+
+
+class Archive:
+    """A zip archive of side files (a GLB, PNG and JSON per generated scene): one output file instead of a folder.
+    Entries carry a fixed date, so the same files give the same bytes."""
+
+    def __init__(self, zipfile_: zipfile.ZipFile):
+        self._zip = zipfile_
+
+    def add(self, name: str, data: bytes) -> None:
+        info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+        info.compress_type = zipfile.ZIP_DEFLATED
+        self._zip.writestr(info, data)
+
+    def add_figure(self, name: str, figure, **savefig) -> None:
+        """A matplotlib figure as a PNG entry (``figure_png``)."""
+        self.add(name, figure_png(figure, **savefig))
+
+    def add_json(self, name: str, value) -> None:
+        self.add(name, json.dumps(value, indent=2).encode())
+
+
+@contextmanager
+def write_archive(path: str | Path) -> Iterator[Archive]:
+    """Open a zip archive to add entries to; written whole to a temporary file, renamed onto ``path`` at the end."""
+    with _temporary(Path(path)) as tmp, zipfile.ZipFile(tmp, "w") as zf:
+        yield Archive(zf)
+
+
+def read_archive(path: str | Path) -> dict[str, bytes]:
+    """Every entry of an archive written by ``write_archive``: name -> bytes."""
+    try:
+        with zipfile.ZipFile(path) as zf:
+            return {name: zf.read(name) for name in zf.namelist()}
+    except (OSError, zipfile.BadZipFile) as exc:
+        raise PlanitError(f"{path}: not a readable scene archive ({exc})") from exc
 
 
 def write_atomic(path: str | Path, write_to) -> Path:
@@ -444,6 +490,25 @@ def write_figure(path: str | Path, figure, **savefig) -> Path:
         return _atomic(Path(path), lambda tmp: figure.savefig(tmp, format=fmt, **savefig))
     finally:
         plt.close(figure)
+
+
+def figure_png(figure, **savefig) -> bytes:
+    """A matplotlib figure as PNG bytes, then closed (as ``write_figure``)."""
+    import matplotlib.pyplot as plt
+
+    buffer = io.BytesIO()
+    try:
+        figure.savefig(buffer, format="png", **savefig)
+    finally:
+        plt.close(figure)
+    return buffer.getvalue()
+
+
+def write_image(path: str | Path, pixels) -> Path:
+    """An image from an (H, W, 3 or 4) array of floats in [0, 1], written atomically as PNG."""
+    from matplotlib.image import imsave
+
+    return _atomic(Path(path), lambda tmp: imsave(tmp, pixels, format="png"))
 
 
 def read(path: str | Path, name: str | None = None, filters=None, columns: list[str] | None = None) -> pa.Table:

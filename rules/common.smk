@@ -5,6 +5,7 @@ import sys
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
+from snakemake.io import is_flagged
 
 try:
     from pipeline import config as planit_config
@@ -149,6 +150,16 @@ def stage_io(name):
         return " ".join(parts)
 
     return options
+
+
+def refuse_folders(rules):
+    """Refuse a workflow whose rules read or write a folder; a stage reads and writes files (an archive where it
+    writes many). Called once every rule is defined."""
+    for r in rules:
+        folders = sorted(str(f) for f in [*r.input, *r.output] if is_flagged(f, "directory"))
+        if folders:
+            raise WorkflowError(f"the rule {r.name} reads or writes folders {folders}; a stage's inputs and "
+                                "outputs are files (an archive where it writes many)")
 
 
 def shards_of(template, **fixed):

@@ -47,7 +47,7 @@ rule generate:
     output:
         **{t: GENERATED.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
         summary=GENERATED.replace("{name}", "summary.json"),
-        files=directory(GENERATED.replace("{name}", "scenes")),
+        archive=GENERATED.replace("{name}", "scenes.zip"),
     params:
         config=method_keys,
         io=stage_io("generate"),
@@ -77,7 +77,7 @@ rule instantiate:
     output:
         **{t: ABLATION.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
         summary=ABLATION.replace("{name}", "summary.json"),
-        files=directory(ABLATION.replace("{name}", "scenes")),
+        archive=ABLATION.replace("{name}", "scenes.zip"),
     params:
         config=variant_keys,
         io=stage_io("instantiate"),
@@ -106,7 +106,7 @@ rule place_graphs:
     output:
         **{t: SPEC.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
         summary=SPEC.replace("{name}", "summary.json"),
-        files=directory(SPEC.replace("{name}", "scenes")),
+        archive=SPEC.replace("{name}", "scenes.zip"),
     params:
         config=keys(*search_keys(config, "planit")),
         io=stage_io("place_graphs"),
@@ -136,7 +136,7 @@ rule complete_room:
     output:
         **{t: COMPLETE.replace("{name}", f"{t}.parquet") for t in ("rooms", "architecture", "objects", "models", "scenes")},
         summary=COMPLETE.replace("{name}", "summary.json"),
-        files=directory(COMPLETE.replace("{name}", "scenes")),
+        archive=COMPLETE.replace("{name}", "scenes.zip"),
     params:
         config=keys(*search_keys(config, "heldout")),
         io=stage_io("complete_room"),

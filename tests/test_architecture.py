@@ -57,6 +57,16 @@ def test_a_rule_whose_files_differ_from_its_stage_declaration_is_refused(tmp_pat
     assert out.returncode != 0 and "the rule symmetry names inputs ['modelz']" in out.stdout + out.stderr
 
 
+def test_a_rule_with_a_folder_valued_output_is_refused(tmp_path):
+    """No rule reads or writes a folder: the workflow refuses one, named, when it is parsed."""
+    extra = tmp_path / "Snakefile"
+    extra.write_text('rule shots:\n    output:\n        shots=directory("shots")\n    shell:\n        "mkdir {output}"\n\n'
+                     f'include: "{ROOT}/Snakefile"\n')
+    out = subprocess.run([str(BIN / "snakemake"), "shots", "-s", str(extra), "-d", str(tmp_path), "-n", "--configfile",
+                          str(ROOT / "config/config.yaml")], capture_output=True, text=True, timeout=300)
+    assert out.returncode != 0 and "the rule shots reads or writes folders ['shots']; " in out.stdout + out.stderr
+
+
 def _imports(path: Path) -> set[str]:
     """Every module a file imports, at any depth (function-level imports included), as absolute names."""
     tree = ast.parse(path.read_text())

@@ -1,4 +1,5 @@
 """Real Snakemake runs of the whole workflow on the tiny config (config/tiny.yaml)."""
+import io
 import json
 import os
 import re
@@ -7,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 import pytest
@@ -209,9 +211,12 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
         sampled = pd.read_parquet(res / "graph_model" / room_type / "sampled" / "nodes.parquet").scene_id.nunique()
         assert len(scenes) == min(2, sampled)  # failed scenes are recorded, never dropped
         assert set(scenes.status) <= {"placed", "failed"} and (scenes[scenes.status == "failed"].reason != "").all()
+        entries = tables.read_archive(folder / "scenes.zip")  # one file, no folder: a GLB, PNG and JSON per scene
+        assert sorted(entries) == sorted(f"{s}.{ext}" for s in scenes.scene_id for ext in ("glb", "json", "png"))
+        assert all(data for data in entries.values())
         for scene in scenes.scene_id:
-            for ext in ("glb", "png", "json"):
-                assert (folder / "scenes" / f"{scene}.{ext}").stat().st_size > 0
+            assert json.loads(entries[f"{scene}.json"])["status"] == scenes.set_index("scene_id").status[scene]
+            assert entries[f"{scene}.png"].startswith(b"\x89PNG") and entries[f"{scene}.glb"].startswith(b"glTF")
         objs = pd.read_parquet(folder / "objects.parquet")
         assert (objs.scene_id == objs.room_id).all()
         assert objs.groupby("room_id").size().reindex(scenes.scene_id, fill_value=0).tolist() == scenes.placed_objects.tolist()
@@ -298,12 +303,28 @@ def test_the_report_gathers_counts_tables_curves_evaluation_and_gallery(run_dir)
     for item in ("results/filter/rule_counts.tsv", "results/graphs/ingested/report/table1.csv",
                  "results/generated/bedroom/table3.csv", "results/eval/bedroom/metrics.csv", "results/runtime.csv"):  # the tables' CSV files are for programs
         assert f'"{item}": {{' not in html, item
-    gallery = sorted((run_dir / "results" / "eval" / "bedroom" / "gallery").glob("*.png"))
-    assert any(p.name.startswith("real_") for p in gallery)
-    for png in gallery:  # each gallery image is embedded whole, as a PNG
-        entry = html[html.index(f'"results/eval/bedroom/gallery/{png.name}": {{'):]
-        data = re.search(r'"data_uri": "data:image/png;[^"]*?base64,([A-Za-z0-9+/=]+)"', entry).group(1)
-        assert base64.b64decode(data) == png.read_bytes()
+    gallery = run_dir / "results" / "eval" / "bedroom" / "gallery.png"  # embedded whole, as a PNG
+    entry = html[html.index('"results/eval/bedroom/gallery.png": {'):]
+    data = re.search(r'"data_uri": "data:image/png;[^"]*?base64,([A-Za-z0-9+/=]+)"', entry).group(1)
+    assert base64.b64decode(data) == gallery.read_bytes()
+
+
+def test_the_gallery_tiles_generated_rooms_above_real_ones(run_dir):
+    """Two rows of figures: the first method's scenes (their archive's PNGs), then held-out real rooms."""
+    from matplotlib.image import imread
+
+    from pipeline.evaluation.gallery import tile
+
+    res = run_dir / "results"
+    image = imread(res / "eval" / "bedroom" / "gallery.png")
+    entries = tables.read_archive(res / "generated" / "bedroom" / "planit" / "scenes.zip")
+    scenes = pd.read_parquet(res / "generated" / "bedroom" / "planit" / "scenes.parquet")
+    first = imread(io.BytesIO(entries[f"{scenes[scenes.status == 'placed'].scene_id.iloc[0]}.png"]), format="png")
+    assert image.shape[0] == 2 * first.shape[0] and image.shape[1] >= first.shape[1]
+    assert np.allclose(image[:first.shape[0], :first.shape[1], :3], first[..., :3], atol=1 / 255)
+    assert not np.allclose(image[first.shape[0]:, :first.shape[1], :3], 1)  # a real room drawn below
+    grid = tile([[entries[n] for n in sorted(entries) if n.endswith(".png")][:1], []])
+    assert grid.shape[:2] == (2 * first.shape[0], first.shape[1]) and (grid[first.shape[0]:] == 1).all()
 
 
 def test_the_report_renders_in_headless_chromium_and_its_gallery_images_load(run_dir, tmp_path):
@@ -317,24 +338,16 @@ def test_the_report_renders_in_headless_chromium_and_its_gallery_images_load(run
         browser.open(report.as_uri())
         browser.click_text("6. Gallery")
         browser.click_text("bedroom")
-        shown, images = [], ("return Array.from(document.images).filter(i => i.src.startsWith('data:image/png'))"
-                             ".map(i => [i.src.split(';')[2], i.complete, i.naturalWidth])")
-        toggles, eyes = "label[for^='toggle-room-']", "tbody tr a[iconname='eye']"
-        views = len(browser.elements(toggles))  # two rooms become a toggle, not table rows (Snakemake's layout)
-        for t in range(max(views, 1)):
-            if views:
-                browser.click(browser.elements(toggles)[t])
-            for k in range(len(browser.elements(eyes))):
-                before = browser.run(images)
-                browser.click(browser.elements(eyes)[k])
-                now = browser.wait_for(lambda: [i for i in browser.run(images) if i not in before and i[1]], timeout=20)
-                shown += now or browser.run(images)  # the app re-renders at its own pace on a loaded machine
+        images = ("return Array.from(document.images).filter(i => i.src.startsWith('data:image/png'))"
+                  ".map(i => [i.src.split(';')[2], i.complete, i.naturalWidth])")
+        before = browser.run(images)
+        browser.click(browser.elements("tbody tr a[iconname='eye']")[0])
+        shown = browser.wait_for(lambda: [i for i in browser.run(images) if i not in before and i[1]], timeout=20)
         shot = browser.screenshot(tmp_path / "gallery.png")
     finally:
         browser.close()
-    names = sorted(p.name for p in (run_dir / "results/eval/bedroom/gallery").glob("*.png"))
-    assert sorted({s[0].removeprefix("filename=") for s in shown}) == names
-    assert all(complete and width >= 400 for _, complete, width in shown)  # decoded, at the figure's size
+    assert [s[0].removeprefix("filename=") for s in shown] == ["gallery.png"]
+    assert all(complete and width >= 400 for _, complete, width in shown)  # decoded, at the figures' size
     assert shot.stat().st_size > 10_000
 
 

@@ -5,6 +5,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from pipeline import tables
+from pipeline.errors import PlanitError
 
 
 def rows():
@@ -66,3 +67,24 @@ def test_a_written_figure_is_closed_even_when_the_write_fails(tmp_path):
     with pytest.raises(ValueError):
         tables.write_figure(tmp_path / "b.unknown_format", plt.subplots()[0])
     assert plt.get_fignums() == [] and sorted(os.listdir(tmp_path)) == ["a.png"]
+
+
+def test_an_archive_is_written_whole_and_the_same_entries_give_the_same_bytes(tmp_path):
+    def write(path, fail=False):
+        with tables.write_archive(path) as archive:
+            archive.add("s0.glb", b"glTF" + bytes(100))
+            archive.add_json("s0.json", {"status": "placed"})
+            if fail:
+                raise RuntimeError("scene 1 broke")
+
+    write(tmp_path / "a.zip")
+    os.utime(tmp_path / "a.zip", (0, 0))
+    write(tmp_path / "b.zip")
+    assert (tmp_path / "a.zip").read_bytes() == (tmp_path / "b.zip").read_bytes()  # no clock in the entries
+    assert tables.read_archive(tmp_path / "a.zip") == {"s0.glb": b"glTF" + bytes(100), "s0.json": b'{\n  "status": "placed"\n}'}
+    with pytest.raises(RuntimeError):
+        write(tmp_path / "c.zip", fail=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.zip", "b.zip"]  # nothing half-written left
+    (tmp_path / "bad.zip").write_bytes(b"not a zip")
+    with pytest.raises(PlanitError, match="bad.zip: not a readable scene archive"):
+        tables.read_archive(tmp_path / "bad.zip")

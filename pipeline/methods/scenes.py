@@ -1,14 +1,13 @@
 """Generated rooms as canonical tables (every stage reads them unchanged), one record per scene (failed ones
-included, with their reason), and per scene a GLB, a top-down PNG with the planned graph and a JSON summary: the one
-writer of every method's rooms. The canonical tables hold the scored scenes only (placed, or partial with what they
-dropped named in their record): a failed scene's unfinished room is kept in its scene files alone, so no reader of
-the tables can take it for a room."""
+included, with their reason), and per scene a GLB, a top-down PNG with the planned graph and a JSON summary (entries
+of one zip archive, ``scenes.zip``): the one writer of every method's rooms. The canonical tables hold the scored
+scenes only (placed, or partial with what they dropped named in their record): a failed scene's unfinished room is
+kept in its archive entries alone, so no reader of the tables can take it for a room."""
 from __future__ import annotations
 
 import json
 import logging
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import pandas as pd
 
@@ -52,15 +51,14 @@ class Rows:
         return record
 
 
-def write_scene_files(folder: Path, scene: Scene, record: dict, mesh_of) -> None:
-    """The scene's GLB, top-down PNG (with its planned graph) and JSON record."""
-    folder.mkdir(parents=True, exist_ok=True)
-    export.write_glb(folder / f"{scene.scene_id}.glb", scene.room, scene.walls, mesh_of)
+def write_scene_files(archive: tables.Archive, scene: Scene, record: dict, mesh_of) -> None:
+    """The scene's GLB, top-down PNG (with its planned graph) and JSON record, as entries of the method's archive."""
+    archive.add(f"{scene.scene_id}.glb", export.glb(scene.room, scene.walls, mesh_of))
     consistency = record.get("consistency")
     title = f"{scene.scene_id} ({record['status']}" + (
         f", consistency {consistency:.2f})" if consistency is not None else ")")
-    tables.write_figure(folder / f"{scene.scene_id}.png", export.plan_figure(scene.room, scene.walls, scene.edges, title))
-    tables.write_json(folder / f"{scene.scene_id}.json", record)
+    archive.add_figure(f"{scene.scene_id}.png", export.plan_figure(scene.room, scene.walls, scene.edges, title))
+    archive.add_json(f"{scene.scene_id}.json", record)
 
 
 def write_tables(rows: Rows, corpus: Corpus, out) -> pd.DataFrame:
@@ -74,7 +72,6 @@ def write_tables(rows: Rows, corpus: Corpus, out) -> pd.DataFrame:
     model_rows = pd.concat([tables.read(p, "models", filters=[("model_id", "in", sorted(used))]).to_pandas()
                             for p in (corpus.models if used else [])] + [tables.empty("models").to_pandas()])
     tables.write(out.models, "models", tables.from_rows("models", tables.records(model_rows.drop_duplicates("model_id"))))
-    Path(out.files).mkdir(parents=True, exist_ok=True)
     tables.write(out.scenes, "scenes", tables.from_rows("scenes", rows.records))
     return pd.DataFrame(rows.records, columns=tables.SCHEMAS["scenes"].names)
 
@@ -116,19 +113,20 @@ def _round(value, digits: int):
 
 def write_generated(scenes, corpus: Corpus, method: str, out, meshes: dict, desc: str = "") -> dict:
     """Write every scene of ``scenes`` (an iterator, consumed here) and the method's tables; returns the summary
-    (``out``: rooms, architecture, objects, models, scenes, summary, files)."""
+    (``out``: rooms, architecture, objects, models, scenes, summary, archive)."""
     rows = Rows()
-    for scene in scenes:
-        record = rows.add(scene, corpus, method)
-        if scene.status != "placed":
-            log.warning("scene %s %s: %s", scene.scene_id, scene.status, scene.reason)
-        write_scene_files(Path(out.files), scene, record, meshes.get)
+    with tables.write_archive(out.archive) as archive:
+        for scene in scenes:
+            record = rows.add(scene, corpus, method)
+            if scene.status != "placed":
+                log.warning("scene %s %s: %s", scene.scene_id, scene.status, scene.reason)
+            write_scene_files(archive, scene, record, meshes.get)
     frame = write_tables(rows, corpus, out)
     return summarise(frame)
 
 
 def generate_rooms(layout, name: str, task, out) -> dict:
-    """Run a layout generator on a task and write everything (``out``: the generated tables, ``summary``, ``files``):
+    """Run a layout generator on a task and write everything (``out``: the generated tables, ``summary``, ``archive``):
     what the ``generate`` and ``instantiate`` stages share."""
     summary = write_generated(layout.generate(task), task.corpus, name, out, task.corpus.meshes)
     tables.write_json(out.summary, {"room_type": task.corpus.room_type, "variant": name, **layout.info, **summary})

@@ -42,9 +42,14 @@ def room_scene(room: RoomInput, walls: Walls, mesh_of):
     return scene
 
 
+def glb(room: RoomInput, walls: Walls, mesh_of) -> bytes:
+    """The room as a binary glTF (``room_scene``)."""
+    return room_scene(room, walls, mesh_of).export(file_type="glb")
+
+
 def write_glb(path: Path, room: RoomInput, walls: Walls, mesh_of) -> Path:
-    scene = room_scene(room, walls, mesh_of)
-    return tables.write_atomic(Path(path), lambda tmp: Path(tmp).write_bytes(scene.export(file_type="glb")))
+    data = glb(room, walls, mesh_of)
+    return tables.write_atomic(Path(path), lambda tmp: Path(tmp).write_bytes(data))
 
 
 def plan_figure(room: RoomInput, walls: Walls, edges: list[PlanEdge], title: str):

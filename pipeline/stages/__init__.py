@@ -17,7 +17,7 @@ TRAINING = (one("model", "the trained model"), one("history", "loss per epoch or
             one("curve", "loss curves (PNG)"), one("summary", "training summary (JSON)"))
 GENERATED = (one("rooms"), one("architecture"), one("objects"), one("models"),
              one("scenes", "one record per scene, failed ones with their reason"), one("summary", "JSON"),
-             one("files", "folder of a GLB, PNG and JSON per scene"))
+             one("archive", "zip archive of a GLB, PNG and JSON per scene"))
 
 _ALL = [
     Stage("ingest", "Read one shard of the configured source into canonical tables.",
@@ -113,13 +113,13 @@ _ALL = [
     Stage("evaluate", "Score every method's rooms and the held-out real rooms of one room type with the same "
           "metrics.", inputs=(many("summaries", "one per generated set (its name: the summary's method)"),
                               many("generated_rooms"), many("generated_architecture"), many("generated_objects"),
-                              many("generated_scenes"), many("generated_files", "each set's scene files (gallery)"),
+                              many("generated_scenes"), many("generated_archives", "each set's scene archive (gallery)"),
                               *CORPUS_SHARDS, *GRAPHS, SPLIT, one("symmetry")),
           outputs=(one("metrics"), one("scenes"), one("table", "the sets side by side (CSV)"),
                    one("table_html", "every method beside the real rooms with intervals, the functional checks, the "
                        "classifier and its power check, the goals (HTML)"),
                    one("power", "the classifier's power check (PNG)"),
-                   one("gallery", "folder of generated and real rooms (PNG, GLB)")), params=(ROOM_TYPE,),
+                   one("gallery", "generated and held-out real rooms side by side (PNG)")), params=(ROOM_TYPE,),
           threads=True),
     Stage("runtime", "Job seconds and peak memory per rule from the benchmark files, and the run's wall-clock span.",
           inputs=(many("corpus", "the corpus stages' outputs (their jobs are timed; read for their presence)"),

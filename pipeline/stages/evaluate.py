@@ -28,6 +28,6 @@ def run(config: dict, inp: Files, out: Files, room_type: str, threads: int = 1) 
     tables.write_csv(out.table, metrics_table(metrics))
     write_html(out.table_html, evaluation_page(metrics))
     tables.write_figure(out.power, power_figure(metrics), dpi=110)
-    gallery(out.gallery, gen[0], Path(inp.generated_files[0]), real, inp.nodes, inp.edges, config["evaluate"]["gallery"])
+    gallery(out.gallery, gen[0], Path(inp.generated_archives[0]), real, inp.nodes, inp.edges, config["evaluate"]["gallery"])
     tables.write_json(out.metrics, metrics)
     return {name: s["category_kl"] for name, s in metrics["sets"].items()}
