@@ -175,7 +175,11 @@ def test_an_object_with_no_place_fails_the_scene_or_is_dropped_with_what_it_supp
         assert out.status == "failed" and "no place for b (bed)" in out.reason and out.room.object_ids == []
     else:
         assert out.status == "partial" and out.dropped == ["b", "l"] and out.room.object_ids == ["n"]
-        assert out.reason.startswith("dropped 2 of 3 objects (") and out.reason.endswith("): b, l")
+        assert out.reason == ("dropped 2 of 3 objects: no place once the backtrack budget was spent: b (bed); "
+                              "support dropped: l (table_lamp)")
+        assert [(d["id"], d["category"], d["cause"]) for d in out.drops] == [("b", "bed", "no_place"),
+                                                                           ("l", "table_lamp", "support_dropped")]
+        assert out.drops[0]["check"] == "outside" and out.drops[1]["check"] is None  # the bed sticks out of the room
         # the bed's wall edge and the lamp's support edge count as not found; the nightstand's wall edge holds
         c = scene_metrics.consistency(plan, out.room, walls.ids, checker, out.dropped)
         assert c["planned_edges"] == 3 and c["consistency"] <= 1 / 3
@@ -194,6 +198,8 @@ def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_c
         assert out.room.object_ids == []  # failed before placing the nightstand
     else:
         assert out.status == "partial" and out.dropped == ["v"] and out.room.object_ids == ["n"]
+        assert out.drops == [{"id": "v", "category": "vacuum_cleaner", "cause": "no_model", "check": None}]
+        assert out.reason == "dropped 1 of 2 objects: no training instance: v (vacuum_cleaner)"
 
 
 def test_the_time_budget_ends_a_scene_with_its_reason():

@@ -7,6 +7,7 @@ import json
 from dataclasses import replace
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from conftest import default_config
@@ -15,7 +16,7 @@ from pipeline.geometry.boxes import SIDES
 from pipeline.geometry.frames import Frame
 from pipeline.geometry.function import sides
 from pipeline.methods.interface import Scene
-from pipeline.methods.scenes import Rows, plan_loss
+from pipeline.methods.scenes import Rows, drops, plan_loss
 from pipeline.placement import poses, scene_metrics
 from pipeline.placement.plan import PlanEdge
 from pipeline.placement.search import Anchor
@@ -123,3 +124,12 @@ def test_a_floor_node_with_planned_spatial_edges_takes_an_instance_that_stood_on
     rng = np.random.default_rng(0)
     assert {pool.pick("counter_top", "none", rng, grounded=True).model_id for _ in range(20)} == {"cabinet"}
     assert {pool.pick("counter_top", "none", rng).model_id for _ in range(40)} == {"slab", "cabinet"}
+
+
+def test_objects_left_out_are_summed_by_category_and_cause():
+    rows = pd.Series([json.dumps([{"id": "a", "category": "counter", "cause": "no_place", "check": "violates"},
+                                  {"id": "b", "category": "toaster", "cause": "support_dropped", "check": None}]),
+                      json.dumps([{"id": "c", "category": "counter", "cause": "no_place", "check": "violates"},
+                                  {"id": "d", "category": "counter", "cause": "no_place", "check": "collides"}]),
+                      "[]", None])
+    assert drops(rows) == {"counter": {"no_place:collides": 1, "no_place:violates": 2}, "toaster": {"support_dropped": 1}}

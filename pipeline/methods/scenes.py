@@ -92,7 +92,7 @@ def summarise(scenes: pd.DataFrame) -> dict:
             "collision_rate": _round(total("colliding_objects") / max(total("placed_objects"), 1), 4),
             "median_seconds": _round(scenes["seconds"].median(), 3),
             "unplanned_adjacent_per_scene": _round(scenes["unplanned_adjacent"].mean(), 3),
-            "plan_loss": plan_loss(scenes.loc[scored, "plan_loss"])}
+            "plan_loss": plan_loss(scenes.loc[scored, "plan_loss"]), "drops": drops(scenes.loc[scored, "drops"])}
 
 
 def plan_loss(rows: pd.Series) -> dict:
@@ -105,6 +105,18 @@ def plan_loss(rows: pd.Series) -> dict:
                 acc[k] = acc.get(k, 0) + n
     return {r: {"planned": c["planned"], **{k: round(n / c["planned"], 4) for k, n in c.items() if k != "planned"}}
             for r, c in sorted(total.items())}
+
+
+def drops(rows: pd.Series) -> dict:
+    """Category -> cause (``no_place:<check>`` for an object no candidate of which passed) -> objects left out,
+    over the scenes' ``drops`` JSON rows."""
+    total: dict = {}
+    for row in rows.dropna():
+        for d in json.loads(row):
+            cause = f"{d['cause']}:{d['check']}" if d.get("check") else d["cause"]
+            acc = total.setdefault(d["category"], {})
+            acc[cause] = acc.get(cause, 0) + 1
+    return {c: dict(sorted(v.items())) for c, v in sorted(total.items())}
 
 
 def _round(value, digits: int):

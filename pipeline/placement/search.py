@@ -73,6 +73,7 @@ class Outcome:
     backtracks: int = 0
     failures: dict = field(default_factory=dict)  # reason kind -> count
     dropped: list = field(default_factory=list)  # plan ids left out (on_exhausted: drop), in the order dropped
+    drops: list = field(default_factory=list)  # per dropped id: its category, cause and (no_place) the check that refused it most
     attempts: int = 1  # searches from scratch (1 + restarts used)
     accepted: dict = field(default_factory=dict)  # PlanEdge -> its cost when the later of its two ends was placed
 
@@ -81,6 +82,8 @@ class Outcome:
         return "failed" if not self.ok else "partial" if self.dropped else "placed"
 
 
+DROP_CAUSES = {"no_place": "no place once the backtrack budget was spent", "no_model": "no training instance",
+               "support_dropped": "support dropped"}
 SCORED = ("placed", "partial")  # the statuses of scenes that hold a room to score (a partial one lacks what it dropped)
 
 
@@ -198,6 +201,8 @@ class Search:
         self.backtracks = self.rejections = self.insertions = 0
         self.failures: dict[str, int] = {}
         self.dropped: list[str] = []
+        self.drops: list[dict] = []  # why each was dropped (``drop``)
+        self.refusals: dict[str, Counter] = {}  # plan id -> rejections by check (``nowhere`` included)
         self.accepted: dict = {}  # PlanEdge -> cost when its later end was last placed
         self.exhausted = False  # the backtrack budget ran out (the one failure a restart may cure)
         self._free = None  # the last free_floor: (room boxes and grow, cells)
@@ -299,6 +304,7 @@ class Search:
         if blocked is not None:
             log.debug("%s %s: no free cell in every planned band", self.plan.scene_id, v)
             self.failures["nowhere"] = self.failures.get("nowhere", 0) + 1
+            self.refusals.setdefault(v, Counter())["nowhere"] += 1
             return blocked
         best = None  # with relaxed relations: the cheapest acceptable candidate so far (room, verdict)
         for _ in range(budget):
@@ -319,6 +325,7 @@ class Search:
             log.debug("%s %s (%s) at %.2f, %.2f: %s", self.plan.scene_id, v, self.plan.categories[k], box[0], box[1], verdict.reason)
             kind = verdict.reason.split(" ")[0]
             self.failures[kind] = self.failures.get(kind, 0) + 1
+            self.refusals.setdefault(v, Counter())[kind] += 1
             self.rejected.setdefault(v, []).append((float(xy[0]), float(xy[1])))
             culprits |= verdict.culprits
         return culprits if best is None else self.accept(*best)
@@ -329,6 +336,16 @@ class Search:
         self.insertions += 1
         self.accepted.update(verdict.edge_costs)
         return None
+
+    def drop(self, k: int, cause: str) -> None:
+        """Leave object ``k`` out (``on_exhausted: drop``), recording why: ``no_model`` (no training instance of its
+        category), ``support_dropped`` (what it stands on was left out) or ``no_place`` (its budget spent; ``check``:
+        the check that refused its candidates most)."""
+        v = self.plan.ids[k]
+        self.dropped.append(v)
+        refused = self.refusals.get(v)
+        self.drops.append({"id": v, "category": self.plan.categories[k], "cause": cause,
+                           "check": refused.most_common(1)[0][0] if cause == "no_place" and refused else None})
 
     def run(self, deadline: float) -> str:
         """Place every object in order; '' on success, else why the scene failed."""
@@ -345,7 +362,7 @@ class Search:
                 return f"time budget ({self.cfg['time_budget']} s) spent at object {i + 1} of {len(self.order)}"
             k = self.order[i]
             if k in missing or self.plan.parent[k] in self.dropped:  # no model, or its support was left out
-                self.dropped.append(self.plan.ids[k])
+                self.drop(k, "no_model" if k in missing else "support_dropped")
                 i += 1
                 continue
             culprits = self.try_place(k)
@@ -354,7 +371,7 @@ class Search:
                 continue
             if self.backtracks >= self.cfg["max_backtracks"]:
                 if self.cfg["on_exhausted"] == "drop":
-                    self.dropped.append(self.plan.ids[k])
+                    self.drop(k, "no_place")
                     i += 1
                     continue
                 self.exhausted = True
@@ -392,9 +409,10 @@ def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int]
             break
     ok = not reason
     if ok and s.dropped:
-        reason = f"dropped {len(s.dropped)} of {len(order)} objects (no place once the backtrack budget was spent, no " \
-                 f"training model, or their support dropped): {', '.join(s.dropped)}"
+        by_cause = {c: ", ".join(f"{d['id']} ({d['category']})" for d in s.drops if d["cause"] == c) for c in DROP_CAUSES}
+        reason = f"dropped {len(s.dropped)} of {len(order)} objects: " + "; ".join(
+            f"{DROP_CAUSES[c]}: {ids}" for c, ids in by_cause.items() if ids)
     total = lambda name: sum(getattr(r, name) for r in runs)
     failures = sum((Counter(r.failures) for r in runs), Counter())
     return Outcome(ok, s.room, reason, time.perf_counter() - start, total("insertions"), total("rejections"),
-                   total("backtracks"), dict(failures), s.dropped, len(runs), s.accepted)
+                   total("backtracks"), dict(failures), s.dropped, s.drops, len(runs), s.accepted)

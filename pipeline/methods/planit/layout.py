@@ -92,6 +92,7 @@ def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
     record = {"seconds": outcome.seconds, "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids),
               "insertions": outcome.insertions, "rejections": outcome.rejections, "backtracks": outcome.backtracks,
               "attempts": outcome.attempts, "failures": json.dumps(outcome.failures),
+              "drops": json.dumps(outcome.drops),
               **scene_metrics.consistency(plan, room, walls.ids, ctx.checker, outcome.dropped, outcome.accepted),
               "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
     return Scene(plan.scene_id, plan.room_id, room, walls, outcome.status, outcome.reason, record, plan.edges, parents)
