@@ -22,20 +22,23 @@ def arguments(doc: str, workdir: Path = OUT) -> argparse.ArgumentParser:
 
 
 def search_flags(ap: argparse.ArgumentParser) -> None:
-    """``--[no-]early-backtrack``, ``--restarts N``, ``--[no-]pose-rules``, ``--[no-]keep-relations`` and
-    ``--[no-]relations-first``: the search settings a bench may set (default: the config's)."""
+    """``--[no-]early-backtrack``, ``--restarts N``, ``--[no-]pose-rules``, ``--[no-]keep-relations``,
+    ``--[no-]relations-first`` and ``--[no-]free-support``: the search settings a bench may set (default: the
+    config's)."""
     ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
     ap.add_argument("--restarts", type=int)
     ap.add_argument("--pose-rules", action=argparse.BooleanOptionalAction)
     ap.add_argument("--keep-relations", action=argparse.BooleanOptionalAction)
     ap.add_argument("--relations-first", action=argparse.BooleanOptionalAction)
+    ap.add_argument("--free-support", action=argparse.BooleanOptionalAction)
 
 
 def search_overrides(args) -> dict:
     """The ``instantiate`` keys :func:`search_flags` set on the command line (nested sections partly: merge them with
     :func:`pipeline.config.deep_merge`)."""
     out = {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts),
-                             ("keep_relations", args.keep_relations)) if v is not None}
+                             ("keep_relations", args.keep_relations), ("free_support", args.free_support))
+           if v is not None}
     out |= {} if args.pose_rules is None else {"pose_rules": {"enabled": args.pose_rules}}
     return out | ({} if args.relations_first is None else {"checks": {"relations_first": args.relations_first}})
 
@@ -46,7 +49,8 @@ def search_suffix(args) -> str:
             + (f"_restarts{args.restarts}" if args.restarts is not None else "")
             + {True: "_pose_rules", False: "_no_pose_rules", None: ""}[args.pose_rules]
             + {True: "_keep_relations", False: "_no_keep_relations", None: ""}[args.keep_relations]
-            + {True: "_relations_first", False: "_collisions_first", None: ""}[args.relations_first])
+            + {True: "_relations_first", False: "_collisions_first", None: ""}[args.relations_first]
+            + {True: "_free_support", False: "_no_free_support", None: ""}[args.free_support])
 
 
 def default_config() -> dict:

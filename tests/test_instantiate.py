@@ -439,3 +439,27 @@ def test_the_free_floor_kept_between_samples_follows_every_insertion_and_backtra
         assert np.array_equal(s.free_floor(half), s.grid.floor & ~covered)
     s.room = with_objects(s.room, [])  # backtracked
     assert np.array_equal(s.free_floor(half), s.grid.floor)
+
+
+@pytest.mark.parametrize("free", [True, False])
+def test_a_supported_object_is_offered_the_part_of_its_support_no_sibling_covers(free):
+    """A desk with a lamp on its left half: with ``free_support`` a second object's candidate centres avoid the lamp's
+    footprint grown by the object's smaller half extent; every other cell of the desk's top stays; without it the
+    whole top is offered, as before."""
+    from pipeline.placement.search import Search
+
+    room, walls, pool, checker, ic = setup(["desk", "table_lamp"], free_support=free)
+    plan = bedroom_plan()
+    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()), pool,
+               checker, ic, np.random.default_rng(0))
+    s.room = add_object(room, "desk", "desk", "m", np.array([2.0, 1.5, 0.375, 0.6, 0.3, 0.375, 0.0]),
+                        np.array([2.0, 1.5, 0.0, 0.0, 1.0, 1.0, 1.0]))
+    s.room = add_object(s.room, "lamp", "table_lamp", "m", np.array([1.6, 1.5, 0.95, 0.1, 0.1, 0.2, 0.0]),
+                        np.array([1.6, 1.5, 0.75, 0.0, 1.0, 1.0, 1.0]))
+    cells, pts = s.free_top(0, np.array([0.15, 0.1])), s.grid.points
+    on_desk = (np.abs(pts[:, 0] - 2.0) <= 0.6) & (np.abs(pts[:, 1] - 1.5) <= 0.3)
+    under_lamp = (np.abs(pts[:, 0] - 1.6) <= 0.2) & (np.abs(pts[:, 1] - 1.5) <= 0.2)
+    assert on_desk.sum() > 100 and (under_lamp & on_desk).sum() > 20
+    assert np.array_equal(cells, on_desk & ~under_lamp if free else on_desk)
+    lamp_top = (np.abs(pts[:, 0] - 1.6) <= 0.1) & (np.abs(pts[:, 1] - 1.5) <= 0.1)
+    assert np.array_equal(s.free_top(1, np.array([0.15, 0.1])), lamp_top)  # nothing stands on the lamp

@@ -239,6 +239,18 @@ class Search:
             self._free = (key, self.grid.floor & ~self.occupied(grow))
         return self._free[1].copy()
 
+    def free_top(self, pk: int, half) -> np.ndarray:
+        """``(cells,)`` candidate centres on placed object ``pk``'s top, with ``free_support`` off the footprints
+        (grown by the smaller of ``half (2,)``) of the objects already standing on it."""
+        pb = self.room.boxes[pk]
+        top = _in_box(self.grid.points, pb, (0.0, 0.0), self.grid.mpp / 2)
+        if not self.cfg["free_support"]:
+            return top
+        b = self.room.boxes.reshape(-1, 7)
+        on = np.abs(b[:, 2] - b[:, 5] - (pb[2] + pb[5])) < self.cfg["checks"]["collision"] + 0.05
+        on[pk] = False
+        return top & ~_in_box(self.grid.points, b[on], (-float(min(half)),) * 2).any(0) if on.any() else top
+
     def band_cells(self, anchors: list[Anchor], half) -> np.ndarray:
         """``(cells,)`` :meth:`free_floor` cells inside every anchor's planned band
         (:class:`~pipeline.placement.proposers.RelationPrior`, no softness)."""
@@ -271,7 +283,7 @@ class Search:
             turns = int(np.round((yaw - pb[6]) / (np.pi / 2)))
             yaw = float(pb[6] + turns * np.pi / 2)
             inset = inst.half[:2][::-1] if turns % 2 else inst.half[:2]
-            mask = _in_box(self.grid.points, pb, inset, self.grid.mpp / 2)
+            mask = _in_box(self.grid.points, pb, inset, self.grid.mpp / 2) & self.free_top(pk, inst.half[:2])
         for x, y in self.rejected.get(v, []):
             mask &= (np.abs(self.grid.points[:, 0] - x) > half) | (np.abs(self.grid.points[:, 1] - y) > half)
         if not mask.any():
@@ -309,7 +321,8 @@ class Search:
         best = None  # with relaxed relations: the cheapest acceptable candidate so far (room, verdict)
         for _ in range(budget):
             cand = self.propose(k, half)
-            if cand is None:
+            if cand is None:  # no free cell left for it (not a rejection: no candidate was drawn)
+                self.refusals.setdefault(v, Counter())["no_cell"] += 1
                 break
             xy, box, pose, model, pk = cand
             room = add_object(self.room, v, self.plan.categories[k], model, box, pose)
@@ -340,7 +353,7 @@ class Search:
     def drop(self, k: int, cause: str) -> None:
         """Leave object ``k`` out (``on_exhausted: drop``), recording why: ``no_model`` (no training instance of its
         category), ``support_dropped`` (what it stands on was left out) or ``no_place`` (its budget spent; ``check``:
-        the check that refused its candidates most)."""
+        the check that refused its candidates most, ``no_cell`` where no free cell was left to draw one from)."""
         v = self.plan.ids[k]
         self.dropped.append(v)
         refused = self.refusals.get(v)
