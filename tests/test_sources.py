@@ -17,6 +17,9 @@ from pipeline import config
 from pipeline.corpus import front3d
 from pipeline.errors import InputError
 from pipeline.stages import ingest
+from pipeline.graphs import data as graph_data
+from pipeline.methods.strings.serialize import parse, serialize, string_graph
+from test_strings import isomorphic
 from conftest import ROOT, shared_data
 
 FIX = Path(__file__).parent / "fixtures"
@@ -154,6 +157,11 @@ def test_front3d_real_sample_runs_through_refinement(tmp_path):
     edges = pd.read_parquet(tmp_path / "results/graphs/ingested/edges.parquet")
     assert edges.room_id.nunique() >= 10 and set(edges.status) == {"kept", "pruned"}
     assert (tmp_path / "results/graphs/ingested/report/table1.csv").exists()
+    nodes = pd.read_parquet(tmp_path / "results/graphs/ingested/nodes.parquet")  # issue 31: real graphs as strings
+    vocab = graph_data.vocab_of(nodes)
+    rng = np.random.default_rng(0)
+    for g in (string_graph(g, vocab) for g in graph_data.graphs_from_tables(nodes, edges, vocab)):
+        assert all(isomorphic(parse(serialize(g, rng)), g) for _ in range(5)), g
 
 
 # ----------------------------------------------------------------------------------------------- AI2-THOR

@@ -1,0 +1,221 @@
+"""Relation graphs as SMILES-like strings (Kalojanov et al. 2019, section 5.1), and back.
+
+A string is a list of tokens:
+
+- an *atom* ``[name]``: a node, named by its class (``wall``, ``door``, ``window`` or an object category);
+- a *bond* ``{label|label}`` between an atom and the atom it leads to: the edges between the two nodes, each label
+  an edge class (:data:`pipeline.graphs.data.EDGE_CLASSES`) after ``>`` (from the earlier atom to the later) or
+  ``<`` (from the later to the earlier), sorted; ``{}`` joins two nodes with no edge between them (a tree edge of
+  the traversal never is one, so ``{}`` appears only after ``.``, below);
+- ``(`` and ``)`` around every branch but the last of an atom;
+- a *ring closure* ``%k``: after an atom, it opens ring ``k`` there; a later ``{bond}%k`` after another atom closes
+  it with that bond (the edges of a cycle the depth-first traversal did not walk, as the wall loop's);
+- ``.`` starts another connected component.
+
+A graph has many strings, one per depth-first order (a start node and an order of each node's neighbours):
+:func:`serialize` draws them from a generator, as the paper trains on several strings per shape. :func:`parse`
+reads any of them back to the same graph (up to node numbering) and names the first malformed token otherwise.
+Pure Python over :class:`~pipeline.graphs.data.Graph`'s arrays; no torch.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import PlanitError
+from ...graphs.data import EDGE_CLASSES, Graph, Vocab
+
+TOKEN = re.compile(r"\[[^\[\]{}()%.]+\]|\{[^{}]*\}|%\d+|[().]")
+
+
+class StringError(PlanitError):
+    """A malformed graph string: which token, where, and why."""
+
+
+@dataclass(frozen=True)
+class StringGraph:
+    """A graph as strings see it. ``names (n,)``: node class names; ``edges (m, 3)``: source, target, edge class."""
+    names: tuple[str, ...]
+    edges: np.ndarray
+
+
+def tokens(text: str) -> list[str]:
+    """The tokens of a string (whitespace between them ignored); a character no token covers is an error."""
+    out, pos = [], 0
+    for m in TOKEN.finditer(text):
+        gap = text[pos:m.start()]
+        if gap.strip():
+            raise StringError(f"character {pos + len(gap) - len(gap.lstrip())}: '{gap.strip()[0]}' begins no token")
+        out.append(m.group())
+        pos = m.end()
+    if text[pos:].strip():
+        raise StringError(f"character {pos}: '{text[pos:].strip()[0]}' begins no token")
+    return out
+
+
+def bond_token(labels: list[tuple[bool, int]]) -> str:
+    """``{>c|<c}`` for ``(forward, edge class)`` pairs: forward edges run from the earlier atom to the later."""
+    return "{" + "|".join(sorted(f"{'>' if fwd else '<'}{EDGE_CLASSES[c]}" for fwd, c in labels)) + "}"
+
+
+def _bonds(graph: StringGraph) -> dict[frozenset, list[tuple[int, int, int]]]:
+    """Unordered node pair -> its edges (source, target, class)."""
+    out: dict[frozenset, list] = {}
+    for s, t, c in graph.edges.tolist():
+        out.setdefault(frozenset((s, t)), []).append((s, t, c))
+    return out
+
+
+def _labels(edges: list[tuple[int, int, int]], earlier: int) -> list[tuple[bool, int]]:
+    return [(s == earlier, c) for s, _, c in edges]
+
+
+def serialize(graph: StringGraph, rng: np.random.Generator | None = None, start: int | None = None) -> str:
+    """One string of the graph: a depth-first traversal from ``start`` (default: node 0, or a random node with
+    ``rng``), each node's unvisited neighbours in index order (or a random order with ``rng``)."""
+    n = len(graph.names)
+    bonds = _bonds(graph)
+    neighbours = [[] for _ in range(n)]
+    for pair in bonds:
+        a, b = tuple(pair)  # no self-loops: a Graph has none
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    order = (lambda xs: [xs[k] for k in rng.permutation(len(xs))]) if rng is not None else sorted
+    starts = list(range(n)) if start is None else [start, *[k for k in range(n) if k != start]]
+    if rng is not None and start is None:
+        starts = order(starts)
+    visited, parts = [False] * n, []
+    for root in starts:
+        if not visited[root]:
+            parts.append(_component(root, graph, bonds, [order(nb) for nb in neighbours], visited))
+    return ".".join(parts)
+
+
+def _component(root: int, graph: StringGraph, bonds: dict, neighbours: list[list[int]], visited: list[bool]) -> str:
+    """The string of ``root``'s component: a first pass finds the traversal tree and the ring (back) edges, a second
+    writes atoms, ring digits and branches."""
+    children: dict[int, list[int]] = {}
+    rings: list[tuple[int, int]] = []  # (opener: earlier in the string, closer)
+    seen_at: dict[int, int] = {}  # node -> place in the string (the pops follow the tree's pre-order)
+    stack = [(root, None)]
+    while stack:
+        node, parent = stack.pop()
+        if visited[node]:
+            continue
+        visited[node] = True
+        seen_at[node] = len(seen_at)
+        if parent is not None:
+            children.setdefault(parent, []).append(node)
+        for nb in reversed(neighbours[node]):
+            if not visited[nb]:
+                stack.append((nb, node))
+    tree = {frozenset((p, c)) for p, cs in children.items() for c in cs}
+    for pair in bonds:
+        if pair not in tree and all(k in seen_at for k in pair):
+            a, b = sorted(pair, key=seen_at.get)
+            rings.append((a, b))
+    return _write(root, graph, bonds, children, rings, seen_at)
+
+
+def _write(root: int, graph: StringGraph, bonds: dict, children: dict, rings: list, seen_at: dict) -> str:
+    """Emit the component in the traversal's order (iteratively: long chains do not hit the recursion limit). At an
+    atom, the rings it closes come first (each with its bond), then the rings it opens, each on the smallest digit
+    not in use."""
+    opening: dict[int, list[int]] = {}
+    closing: dict[int, list[int]] = {}
+    for a, b in sorted(rings, key=lambda r: (seen_at[r[0]], seen_at[r[1]])):
+        opening.setdefault(a, []).append(b)
+        closing.setdefault(b, []).append(a)
+    digit_of: dict[tuple[int, int], int] = {}
+    out, stack = [], [("atom", root)]
+    while stack:
+        kind, value = stack.pop()
+        if kind == "text":
+            out.append(value)
+            continue
+        out.append(f"[{graph.names[value]}]")
+        for a in closing.get(value, []):
+            out.append(bond_token(_labels(bonds[frozenset((a, value))], a)) + f"%{digit_of.pop((a, value))}")
+        for b in opening.get(value, []):
+            used = set(digit_of.values())
+            digit_of[(value, b)] = next(k for k in range(1, len(used) + 2) if k not in used)
+            out.append(f"%{digit_of[(value, b)]}")
+        kids = children.get(value, [])
+        for i in range(len(kids) - 1, -1, -1):
+            branch = i < len(kids) - 1
+            stack += [("text", ")")] * branch + [("atom", kids[i]),
+                       ("text", bond_token(_labels(bonds[frozenset((value, kids[i]))], value)))] + [("text", "(")] * branch
+    return "".join(out)
+
+
+def parse(text: str) -> StringGraph:
+    """The graph of a string written by :func:`serialize` (or generated in its grammar). Raises
+    :class:`StringError` naming the first malformed token: an unknown edge class, a bond with no atom after it, an
+    unclosed branch or ring, a ring closed without a bond, a ``)`` with no ``(``."""
+    names, edges = [], []
+    current, bond, branches, rings = None, None, [], {}
+    for i, tok in enumerate(tokens(text)):
+        where = f"token {i} '{tok}'"
+        if tok.startswith("["):
+            names.append(tok[1:-1])
+            if bond is not None:
+                edges += _edges(bond, current, len(names) - 1, where)
+            elif current is not None:
+                raise StringError(f"{where}: an atom after an atom needs a bond between them")
+            current, bond = len(names) - 1, None
+        elif tok.startswith("{"):
+            if current is None or bond is not None:
+                raise StringError(f"{where}: a bond must follow an atom")
+            bond = tok
+        elif tok.startswith("%"):
+            if current is None:
+                raise StringError(f"{where}: a ring digit must follow an atom")
+            k = int(tok[1:])
+            if k in rings:
+                opener, _ = rings.pop(k)
+                if bond is None:
+                    raise StringError(f"{where}: ring {k} is closed without a bond")
+                edges += _edges(bond, opener, current, where)
+            elif bond is not None:
+                raise StringError(f"{where}: ring {k} is opened with a bond (a bond goes where it closes)")
+            else:
+                rings[k] = (current, i)
+            bond = None
+        elif tok == "(":
+            if current is None or bond is not None:
+                raise StringError(f"{where}: a branch must follow an atom")
+            branches.append(current)
+        elif tok == ")":
+            if not branches or bond is not None:
+                raise StringError(f"{where}: {'no open branch' if not branches else 'a bond with no atom after it'}")
+            current = branches.pop()
+        else:  # "."
+            if bond is not None or branches:
+                raise StringError(f"{where}: '.' inside a branch or after a bond")
+            current = None
+    if bond is not None:
+        raise StringError("the string ends with a bond and no atom after it")
+    if branches:
+        raise StringError(f"{len(branches)} branch(es) not closed at the end of the string")
+    if rings:
+        k, (_, i) = next(iter(rings.items()))
+        raise StringError(f"ring {k} opened at token {i} is never closed")
+    return StringGraph(tuple(names), np.array(edges, np.int64).reshape(-1, 3))
+
+
+def _edges(bond: str, earlier: int, later: int, where: str) -> list[tuple[int, int, int]]:
+    """The edges a bond token gives between two atoms."""
+    out = []
+    for label in filter(None, bond[1:-1].split("|")):
+        arrow, name = label[0], label[1:]
+        if arrow not in "<>" or name not in EDGE_CLASSES:
+            raise StringError(f"{where}: '{label}' in bond {bond} is not '>' or '<' and an edge class")
+        out.append((earlier, later, EDGE_CLASSES.index(name)) if arrow == ">" else (later, earlier, EDGE_CLASSES.index(name)))
+    return out
+
+
+def string_graph(graph: Graph, vocab: Vocab) -> StringGraph:
+    """A final graph (:func:`~pipeline.graphs.data.graphs_from_tables`) as strings see it: class names and edges."""
+    return StringGraph(tuple(vocab.node_classes[c] for c in graph.node_class), graph.edges[:, :3].astype(np.int64))
