@@ -208,6 +208,18 @@ def test_the_time_budget_ends_a_scene_with_its_reason():
     assert not out.ok and out.reason.startswith("time budget (0.3 s) spent")
 
 
+def test_the_candidate_budget_ends_a_scene_the_same_way_on_any_machine():
+    """Work, not seconds: the search stops after exactly ``candidate_budget`` candidates, with its reason, whatever
+    the load (the time budget, far above, is not reached)."""
+    room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, candidate_budget=40, restarts=2)
+    runs = [instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
+            for _ in range(2)]
+    for out in runs:
+        assert not out.ok and out.reason == "candidate budget (40) spent at object 1 of 1"
+        assert out.rejections == 40 and out.attempts == 1  # no restart: a restart cures a spent backtrack budget only
+    assert runs[0].failures == runs[1].failures and runs[0].backtracks == runs[1].backtracks
+
+
 def test_an_l_shaped_room_keeps_furniture_inside_its_outline():
     outline = ((0, 0), (5, 0), (5, 2.5), (2.5, 2.5), (2.5, 5), (0, 5))
     room, walls, pool, checker, ic = setup(["wardrobe", "desk"], outline)

@@ -9,7 +9,8 @@ quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``; 
 that breaks some of its relations within that tolerance is kept only when the object's remaining samples find none
 that keeps them all (the cheapest such candidate is taken). With ``early_backtrack``, an object at zero
 tolerance whose planned bands share no free cell backtracks at once instead of spending its samples. A scene fails, with its reason,
-when the backtrack or time budget runs out, or an object's category has no training instance; with
+when the backtrack or candidate budget runs out (or the time budget, a safety net: the one outcome a machine's
+speed can change), or an object's category has no training instance; with
 ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search goes on.
 A scene whose backtrack budget runs out starts over from scratch with a fresh seed, at most ``restarts`` times (each
 attempt with its own budgets); its counts add up over the attempts.
@@ -198,7 +199,7 @@ class Search:
         self.rejected: dict[str, list[tuple[float, float]]] = {}
         self.shared: dict[tuple, object] = {}
         self.unit = {}
-        self.backtracks = self.rejections = self.insertions = 0
+        self.backtracks = self.rejections = self.insertions = self.candidates = 0
         self.failures: dict[str, int] = {}
         self.dropped: list[str] = []
         self.drops: list[dict] = []  # why each was dropped (``drop``)
@@ -320,10 +321,13 @@ class Search:
             return blocked
         best = None  # with relaxed relations: the cheapest acceptable candidate so far (room, verdict)
         for _ in range(budget):
+            if self.candidates >= self.cfg["candidate_budget"]:
+                break
             cand = self.propose(k, half)
             if cand is None:  # no free cell left for it (not a rejection: no candidate was drawn)
                 self.refusals.setdefault(v, Counter())["no_cell"] += 1
                 break
+            self.candidates += 1
             xy, box, pose, model, pk = cand
             room = add_object(self.room, v, self.plan.categories[k], model, box, pose)
             present = set(self.room.object_ids) | set(self.walls.ids)
@@ -382,6 +386,8 @@ class Search:
             if culprits is None:
                 i += 1
                 continue
+            if self.candidates >= self.cfg["candidate_budget"]:
+                return f"candidate budget ({self.cfg['candidate_budget']}) spent at object {i + 1} of {len(self.order)}"
             if self.backtracks >= self.cfg["max_backtracks"]:
                 if self.cfg["on_exhausted"] == "drop":
                     self.drop(k, "no_place")
