@@ -133,3 +133,38 @@ def test_objects_left_out_are_summed_by_category_and_cause():
                                   {"id": "d", "category": "counter", "cause": "no_place", "check": "collides"}]),
                       "[]", None])
     assert drops(rows) == {"counter": {"no_place:collides": 1, "no_place:violates": 2}, "toaster": {"support_dropped": 1}}
+
+
+def _tv_room(k: int, tv_width: float):
+    """A TV stand 0.9 m wide with a TV of ``tv_width`` on it; a nightstand with a lamp wholly on it."""
+    from conftest import Room
+
+    r = Room([(0, 0), (4, 0), (4, 3), (0, 3)], room_id=f"t{k}", room_type="living")
+    r.add("stand", "tv_stand", (0.9, 0.4, 0.5), (2.0, 0.3)).add("tv", "tv", (tv_width, 0.1, 0.6), (2.0, 0.3), z=0.5)
+    r.add("ns", "nightstand", (0.5, 0.4, 0.55), (0.5, 2.5)).add("lamp", "table_lamp", (0.2, 0.2, 0.4), (0.5, 2.5), z=0.55)
+    return r.room_input()
+
+
+def test_a_tv_wider_than_its_stand_in_every_training_room_may_overhang_it_and_nothing_else_may():
+    from pipeline.placement.checks import Checker, support_share
+    from pipeline.placement.support import learn_support_floor, supported_shares
+
+    checks = {**default_config()["instantiate"]["checks"], "min_support": 0.9}
+    rooms = [_tv_room(k, w) for k, w in enumerate(np.linspace(1.0, 1.2, 12))]  # shares 0.90 .. 0.75
+    assert sorted(c for c, _ in supported_shares(rooms[0], 0.02, 0.04)) == ["table_lamp", "tv"]
+    floor = learn_support_floor(rooms, checks, 0.04)
+    assert list(floor) == ["tv"] and 0.75 <= floor["tv"] <= 0.77  # the low end of 0.75 .. 0.90; lamps stay at 0.9
+    assert learn_support_floor(rooms[:9], checks, 0.04) == {}  # fewer than min_pairs (10) TVs: nothing learned
+    checker = Checker({}, set(), {}, {}, object, checks, floor)
+    wide = _tv_room(99, 1.18)
+    share = support_share(wide.boxes[1], wide.boxes[0])
+    assert 0.76 < share < 0.77 and share >= checker.min_support("tv") and checker.min_support("table_lamp") == 0.9
+    assert checker.min_support("vase") == 0.9
+
+
+def test_a_learned_overhang_never_goes_below_half_the_footprint():
+    from pipeline.placement.support import learn_support_floor
+
+    checks = {**default_config()["instantiate"]["checks"], "min_support": 0.9}
+    rooms = [_tv_room(k, 3.0) for k in range(12)]  # a 3 m TV on a 0.9 m stand: share 0.3
+    assert learn_support_floor(rooms, checks, 0.04) == {"tv": 0.5}

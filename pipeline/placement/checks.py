@@ -47,6 +47,11 @@ class Checker:
     extract_cfg: dict
     intersector: type
     cfg: dict
+    support_floor: dict = field(default_factory=dict)  # category -> learned lower min_support (placement/support.py)
+
+    def min_support(self, category: str) -> float:
+        """The share of its footprint an object of ``category`` must keep over its support."""
+        return min(self.cfg["min_support"], self.support_floor.get(category, 1.0))
 
     def meshes_of(self, room: RoomInput) -> list:
         """Each object's ``(vertices, faces)``, or None where it is measured as its box."""
@@ -133,7 +138,7 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
             return Verdict(False, f"outside the floor ({outside * 1e4:.0f} cm^2 beyond a {checker.cfg['outside']} m margin)")
         if blocks_door(room, corners, checker.cfg["door_clearance"]):
             return Verdict(False, "blocks a door's clearance")
-    elif support_share(room.boxes[k], room.boxes[parent]) < checker.cfg["min_support"]:
+    elif support_share(room.boxes[k], room.boxes[parent]) < checker.min_support(room.categories[k]):
         return Verdict(False, "overhangs its support", culprits={room.object_ids[parent]})
     related = children | ({parent} if parent is not None else set())
     if not checker.cfg["relations_first"]:

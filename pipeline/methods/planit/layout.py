@@ -23,6 +23,7 @@ from ...placement.checks import Checker, checks_config
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.poses import PoseRules, describe, learn_pose_rules
+from ...placement.support import learn_support_floor
 from ...placement.retrieval import ModelPool
 from ...placement.search import instantiate
 from ..interface import Corpus, Scene, Task
@@ -48,15 +49,19 @@ def load_context(config: dict, corpus: Corpus) -> Context:
     sizes = tables.read(corpus.category_sizes, "category_sizes").to_pandas()
     sizes = sizes[sizes["room_type"].astype(str) == corpus.room_type]
     ext = {**config["extract"], "floor_contact": config["floor_contact"]}
-    checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]),
-                      checks_config(config))
+    training = corpus.training()
+    checks = checks_config(config)
+    floor = learn_support_floor(training, checks, config["floor_contact"])
+    checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor)
+    if floor:
+        log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
     objs = corpus.objects
     pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
     rules = config["instantiate"]["pose_rules"]
-    poses = learn_pose_rules(corpus.training(), rules) if rules["enabled"] else None
+    poses = learn_pose_rules(training, rules) if rules["enabled"] else None
     if poses is not None:
         log.info("%s: %d pose rules learned from %d training rooms:\n  %s", corpus.room_type,
-                 len(poses.turns), len(corpus.training()), "\n  ".join(describe(poses)))
+                 len(poses.turns), len(training), "\n  ".join(describe(poses)))
     return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])), poses)
 
 
