@@ -1,12 +1,15 @@
 """The built-in corpus: deterministic, varied, functional, with ground truth for later stages."""
+import json
+import subprocess
+import sys
 from collections import Counter
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
-from pipeline.stage import Files
 from pipeline.corpus import furniture, procedural
 
 
@@ -89,24 +92,34 @@ def test_objects_stand_inside_their_room_without_overlap(corpus):
         assert boxes.penetration_depths(b).max() < 0.01, room_id
 
 
+def planit(stage: str, overrides: dict, inputs: dict, outputs: dict, **params) -> None:
+    """Run one stage as a user runs it: the ``planit`` subcommand of its name, ``--port path`` per input (repeated
+    for lists), ``--out-port path`` per output, the overrides as ``--config-json``."""
+    args = [str(Path(sys.executable).parent / "planit"), stage, "--config-json", json.dumps(overrides)]
+    for prefix, files in (("--", inputs), ("--out-", outputs)):
+        for name, paths in files.items():
+            args += [a for p in (paths if isinstance(paths, list) else [paths]) for a in (prefix + name.replace("_", "-"), str(p))]
+    args += [a for k, v in params.items() for a in (f"--{k.replace('_', '-')}", str(v))]
+    run = subprocess.run(args, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, (stage, run.stderr[-2000:])
+
+
 def test_hard_placements_are_recovered_per_case(tmp_path):
     """Flush, interpenetrating and turned placements (PlanIT's extraction on rooms as hard as real ones): every case
     occurs, and the extraction finds >= 98% of each case's intended adjacencies (ingest -> symmetry -> extraction
-    -> score, the stages themselves on real Parquet and Embree)."""
-    from pipeline import config as config_mod
-    from pipeline.stages import extract_graphs, ingest, score_extraction, symmetry
-
-    cfg = config_mod.validate({"shards": 1, "procedural": {
+    -> score, the planit subcommands on real Parquet and Embree, without the filter in between)."""
+    cfg = {"shards": 1, "procedural": {
         "rooms": {"bedroom": 25, "living": 25, "office": 25, "bathroom": 10, "kitchen": 15}, "defect_rate": 0.0,
-        "placement": {"flush": 0.35, "overlap": 0.35, "turned": 1.0}}})
+        "placement": {"flush": 0.35, "overlap": 0.35, "turned": 1.0}}}
     t = {name: tmp_path / f"{name}.parquet" for name in INGEST_OUTPUTS}
-    ingest.run(cfg, Files(), Files(t), shard=0)
-    symmetry.run(cfg, Files(models=[t["models"]]), Files(table=tmp_path / "symmetry.parquet", agreement=tmp_path / "agreement.json"))
-    extract_graphs.run(cfg, Files(rooms=t["rooms"], architecture=t["architecture"], objects=t["objects"],
-                                  models=t["models"], symmetry=tmp_path / "symmetry.parquet"),
-                       Files(nodes=tmp_path / "nodes.parquet", edges=tmp_path / "edges.parquet", summary=tmp_path / "summary.json"), shard=0)
-    scores = score_extraction.run(cfg, Files(nodes=[tmp_path / "nodes.parquet"], edges=[tmp_path / "edges.parquet"],
-                                             ground_truth=[t["ground_truth"]]), Files(metrics=tmp_path / "scores.json"))
+    raw = {"nodes": tmp_path / "nodes.parquet", "edges": tmp_path / "edges.parquet"}
+    planit("ingest", cfg, {}, t, shard=0)
+    planit("symmetry", cfg, {"models": [t["models"]]}, {"table": tmp_path / "sym.parquet", "agreement": tmp_path / "sym.json"})
+    planit("extract_graphs", cfg, {k: t[k] for k in ("rooms", "architecture", "objects", "models")} | {"symmetry": tmp_path / "sym.parquet"},
+           {**raw, "summary": tmp_path / "summary.json"}, shard=0)
+    planit("score_extraction", cfg, {"nodes": [raw["nodes"]], "edges": [raw["edges"]], "ground_truth": [t["ground_truth"]]},
+           {"metrics": tmp_path / "scores.json"})
+    scores = json.loads((tmp_path / "scores.json").read_text())
     by_case = scores["adjacent_recall_by_case"]
     assert set(by_case) == {"gap", "flush", "overlap", "turned"}
     for case, s in by_case.items():

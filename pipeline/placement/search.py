@@ -395,21 +395,26 @@ class Search:
                     continue
                 self.exhausted = True
                 return f"backtrack budget ({self.cfg['max_backtracks']}) spent: no place for {self.plan.ids[k]} ({self.plan.categories[k]})"
-            self.backtracks += 1
-            if i == 0:  # nothing to undo: the first object tries again afresh
-                self.rejected.pop(self.plan.ids[k], None)
-                continue
-            placed = [self.plan.ids[j] for j in self.order[:i]]
-            earlier = [placed.index(c) for c in culprits if c in placed]
-            j = max(earlier) if earlier else i - 1
-            u = self.plan.ids[self.order[j]]
-            uk = self.room.object_ids.index(u)
-            self.rejected.setdefault(u, []).append(tuple(map(float, self.room.boxes[uk, :2])))
-            for later in self.order[j + 1:]:
-                self.rejected.pop(self.plan.ids[later], None)
-            self.room = with_objects(self.room, np.arange(self.fixed + j))
-            i = j
+            i = self.backtrack(i, culprits)
         return ""
+
+    def backtrack(self, i: int, culprits: set[str]) -> int:
+        """Undo back to the latest placed culprit of object ``order[i]``'s failures (else the object before it),
+        rejecting that object's place; returns the position to go on from."""
+        self.backtracks += 1
+        if i == 0:  # nothing to undo: the first object tries again afresh
+            self.rejected.pop(self.plan.ids[self.order[0]], None)
+            return 0
+        placed = [self.plan.ids[j] for j in self.order[:i]]
+        earlier = [placed.index(c) for c in culprits if c in placed]
+        j = max(earlier) if earlier else i - 1
+        u = self.plan.ids[self.order[j]]
+        uk = self.room.object_ids.index(u)
+        self.rejected.setdefault(u, []).append(tuple(map(float, self.room.boxes[uk, :2])))
+        for later in self.order[j + 1:]:
+            self.rejected.pop(self.plan.ids[later], None)
+        self.room = with_objects(self.room, np.arange(self.fixed + j))
+        return j
 
 
 def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, pool: ModelPool,

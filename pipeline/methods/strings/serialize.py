@@ -154,55 +154,78 @@ def parse(text: str) -> StringGraph:
     """The graph of a string written by :func:`serialize` (or generated in its grammar). Raises
     :class:`StringError` naming the first malformed token: an unknown edge class, a bond with no atom after it, an
     unclosed branch or ring, a ring closed without a bond, a ``)`` with no ``(``."""
-    names, edges = [], []
-    current, bond, branches, rings = None, None, [], {}
+    reader = _Reader()
     for i, tok in enumerate(tokens(text)):
+        reader.read(tok, i)
+    return reader.finish()
+
+
+class _Reader:
+    """The parser's state: atoms and edges so far, the current atom, a pending bond, open branches and rings."""
+
+    def __init__(self):
+        self.names: list[str] = []
+        self.edges: list[tuple[int, int, int]] = []
+        self.current: int | None = None
+        self.bond: str | None = None
+        self.branches: list[int] = []
+        self.rings: dict[int, tuple[int, int]] = {}  # digit -> (opening atom, token index)
+
+    def read(self, tok: str, i: int) -> None:
         where = f"token {i} '{tok}'"
         if tok.startswith("["):
-            names.append(tok[1:-1])
-            if bond is not None:
-                edges += _edges(bond, current, len(names) - 1, where)
-            elif current is not None:
-                raise StringError(f"{where}: an atom after an atom needs a bond between them")
-            current, bond = len(names) - 1, None
+            self.atom(tok[1:-1], where)
         elif tok.startswith("{"):
-            if current is None or bond is not None:
+            if self.current is None or self.bond is not None:
                 raise StringError(f"{where}: a bond must follow an atom")
-            bond = tok
+            self.bond = tok
         elif tok.startswith("%"):
-            if current is None:
-                raise StringError(f"{where}: a ring digit must follow an atom")
-            k = int(tok[1:])
-            if k in rings:
-                opener, _ = rings.pop(k)
-                if bond is None:
-                    raise StringError(f"{where}: ring {k} is closed without a bond")
-                edges += _edges(bond, opener, current, where)
-            elif bond is not None:
-                raise StringError(f"{where}: ring {k} is opened with a bond (a bond goes where it closes)")
-            else:
-                rings[k] = (current, i)
-            bond = None
+            self.ring(int(tok[1:]), i, where)
         elif tok == "(":
-            if current is None or bond is not None:
+            if self.current is None or self.bond is not None:
                 raise StringError(f"{where}: a branch must follow an atom")
-            branches.append(current)
+            self.branches.append(self.current)
         elif tok == ")":
-            if not branches or bond is not None:
-                raise StringError(f"{where}: {'no open branch' if not branches else 'a bond with no atom after it'}")
-            current = branches.pop()
+            if not self.branches or self.bond is not None:
+                raise StringError(f"{where}: {'no open branch' if not self.branches else 'a bond with no atom after it'}")
+            self.current = self.branches.pop()
         else:  # "."
-            if bond is not None or branches:
+            if self.bond is not None or self.branches:
                 raise StringError(f"{where}: '.' inside a branch or after a bond")
-            current = None
-    if bond is not None:
-        raise StringError("the string ends with a bond and no atom after it")
-    if branches:
-        raise StringError(f"{len(branches)} branch(es) not closed at the end of the string")
-    if rings:
-        k, (_, i) = next(iter(rings.items()))
-        raise StringError(f"ring {k} opened at token {i} is never closed")
-    return StringGraph(tuple(names), np.array(edges, np.int64).reshape(-1, 3))
+            self.current = None
+
+    def atom(self, name: str, where: str) -> None:
+        self.names.append(name)
+        if self.bond is not None:
+            self.edges += _edges(self.bond, self.current, len(self.names) - 1, where)
+        elif self.current is not None:
+            raise StringError(f"{where}: an atom after an atom needs a bond between them")
+        self.current, self.bond = len(self.names) - 1, None
+
+    def ring(self, k: int, i: int, where: str) -> None:
+        """Open ring ``k`` at the current atom, or close it there with the pending bond."""
+        if self.current is None:
+            raise StringError(f"{where}: a ring digit must follow an atom")
+        if k in self.rings:
+            opener, _ = self.rings.pop(k)
+            if self.bond is None:
+                raise StringError(f"{where}: ring {k} is closed without a bond")
+            self.edges += _edges(self.bond, opener, self.current, where)
+        elif self.bond is not None:
+            raise StringError(f"{where}: ring {k} is opened with a bond (a bond goes where it closes)")
+        else:
+            self.rings[k] = (self.current, i)
+        self.bond = None
+
+    def finish(self) -> StringGraph:
+        if self.bond is not None:
+            raise StringError("the string ends with a bond and no atom after it")
+        if self.branches:
+            raise StringError(f"{len(self.branches)} branch(es) not closed at the end of the string")
+        if self.rings:
+            k, (_, i) = next(iter(self.rings.items()))
+            raise StringError(f"ring {k} opened at token {i} is never closed")
+        return StringGraph(tuple(self.names), np.array(self.edges, np.int64).reshape(-1, 3))
 
 
 def _edges(bond: str, earlier: int, later: int, where: str) -> list[tuple[int, int, int]]:
