@@ -2,6 +2,7 @@
 the relation check, no network (the relation-band proposer), plus frames, ordering and the GLB export."""
 from __future__ import annotations
 
+import io
 import math
 
 import numpy as np
@@ -263,8 +264,8 @@ def test_the_glb_reloads_with_one_node_per_object_wall_and_the_floor(tmp_path):
     out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
                       pool, checker, ic, 0)
     scene = export.room_scene(out.room, walls, checker.meshes.get)
-    path = export.write_glb(tmp_path / "s0.glb", out.room, walls, checker.meshes.get)
-    back = trimesh.load(path)
+    raw = export.glb(out.room, walls, checker.meshes.get)  # the bytes scenes.zip holds
+    back = trimesh.load(io.BytesIO(raw), file_type="glb")
     names = set(back.graph.nodes_geometry)
     assert names == set(plan.ids) | set(walls.ids) | {"floor"}
     assert len(names) == len(scene.graph.nodes_geometry) == 5 + len(walls.ids) + 1
@@ -272,7 +273,7 @@ def test_the_glb_reloads_with_one_node_per_object_wall_and_the_floor(tmp_path):
     import json
     import struct
 
-    raw = path.read_bytes()  # the glTF JSON chunk: every object node carries its category in its extras
+    # the glTF JSON chunk: every object node carries its category in its extras
     nodes = json.loads(raw[20:20 + struct.unpack("<I", raw[12:16])[0]])["nodes"]
     cats = {n["name"]: n.get("extras", {}).get("category") for n in nodes}
     assert all(cats[o] == c for o, c in zip(out.room.object_ids, out.room.categories))
@@ -468,10 +469,10 @@ def test_a_supported_object_is_offered_the_part_of_its_support_no_sibling_covers
                         np.array([2.0, 1.5, 0.0, 0.0, 1.0, 1.0, 1.0]))
     s.room = add_object(s.room, "lamp", "table_lamp", "m", np.array([1.6, 1.5, 0.95, 0.1, 0.1, 0.2, 0.0]),
                         np.array([1.6, 1.5, 0.75, 0.0, 1.0, 1.0, 1.0]))
-    cells, pts = s.free_top(0, np.array([0.15, 0.1])), s.grid.points
+    cells, pts = s.free_top(0, (0.0, 0.0), np.array([0.15, 0.1])), s.grid.points
     on_desk = (np.abs(pts[:, 0] - 2.0) <= 0.6) & (np.abs(pts[:, 1] - 1.5) <= 0.3)
     under_lamp = (np.abs(pts[:, 0] - 1.6) <= 0.2) & (np.abs(pts[:, 1] - 1.5) <= 0.2)
     assert on_desk.sum() > 100 and (under_lamp & on_desk).sum() > 20
     assert np.array_equal(cells, on_desk & ~under_lamp if free else on_desk)
     lamp_top = (np.abs(pts[:, 0] - 1.6) <= 0.1) & (np.abs(pts[:, 1] - 1.5) <= 0.1)
-    assert np.array_equal(s.free_top(1, np.array([0.15, 0.1])), lamp_top)  # nothing stands on the lamp
+    assert np.array_equal(s.free_top(1, (0.0, 0.0), np.array([0.15, 0.1])), lamp_top)  # nothing stands on the lamp

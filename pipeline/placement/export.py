@@ -2,11 +2,9 @@
 node's extras; walls and floor included) and a top-down PNG with the planned graph drawn over it."""
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
-from .. import tables
 from ..room import RoomInput, Walls, wall_footprints
 from ..geometry import meshes
 from ..geometry.boxes import footprint_corners
@@ -45,11 +43,6 @@ def room_scene(room: RoomInput, walls: Walls, mesh_of):
 def glb(room: RoomInput, walls: Walls, mesh_of) -> bytes:
     """The room as a binary glTF (``room_scene``)."""
     return room_scene(room, walls, mesh_of).export(file_type="glb")
-
-
-def write_glb(path: Path, room: RoomInput, walls: Walls, mesh_of) -> Path:
-    data = glb(room, walls, mesh_of)
-    return tables.write_atomic(Path(path), lambda tmp: Path(tmp).write_bytes(data))
 
 
 def plan_figure(room: RoomInput, walls: Walls, edges: list[PlanEdge], title: str):

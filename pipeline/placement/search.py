@@ -240,11 +240,12 @@ class Search:
             self._free = (key, self.grid.floor & ~self.occupied(grow))
         return self._free[1].copy()
 
-    def free_top(self, pk: int, half) -> np.ndarray:
-        """``(cells,)`` candidate centres on placed object ``pk``'s top, with ``free_support`` off the footprints
-        (grown by the smaller of ``half (2,)``) of the objects already standing on it."""
+    def free_top(self, pk: int, inset, half) -> np.ndarray:
+        """``(cells,)`` candidate centres on placed object ``pk``'s top shrunk by ``inset (2,)`` m (each half extent
+        kept >= half a cell), with ``free_support`` off the footprints (grown by the smaller of ``half (2,)``) of the
+        objects already standing on it."""
         pb = self.room.boxes[pk]
-        top = _in_box(self.grid.points, pb, (0.0, 0.0), self.grid.mpp / 2)
+        top = _in_box(self.grid.points, pb, inset, self.grid.mpp / 2)
         if not self.cfg["free_support"]:
             return top
         b = self.room.boxes.reshape(-1, 7)
@@ -284,7 +285,7 @@ class Search:
             turns = int(np.round((yaw - pb[6]) / (np.pi / 2)))
             yaw = float(pb[6] + turns * np.pi / 2)
             inset = inst.half[:2][::-1] if turns % 2 else inst.half[:2]
-            mask = _in_box(self.grid.points, pb, inset, self.grid.mpp / 2) & self.free_top(pk, inst.half[:2])
+            mask = self.free_top(pk, inset, inst.half[:2])
         for x, y in self.rejected.get(v, []):
             mask &= (np.abs(self.grid.points[:, 0] - x) > half) | (np.abs(self.grid.points[:, 1] - y) > half)
         if not mask.any():

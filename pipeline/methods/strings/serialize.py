@@ -5,8 +5,7 @@ A string is a list of tokens:
 - an *atom* ``[name]``: a node, named by its class (``wall``, ``door``, ``window`` or an object category);
 - a *bond* ``{label|label}`` between an atom and the atom it leads to: the edges between the two nodes, each label
   an edge class (:data:`pipeline.graphs.data.EDGE_CLASSES`) after ``>`` (from the earlier atom to the later) or
-  ``<`` (from the later to the earlier), sorted; ``{}`` joins two nodes with no edge between them (a tree edge of
-  the traversal never is one, so ``{}`` appears only after ``.``, below);
+  ``<`` (from the later to the earlier), sorted (every bond written holds at least one edge);
 - ``(`` and ``)`` around every branch but the last of an atom;
 - a *ring closure* ``%k``: after an atom, it opens ring ``k`` there; a later ``{bond}%k`` after another atom closes
   it with that bond (the edges of a cycle the depth-first traversal did not walk, as the wall loop's);
@@ -72,9 +71,9 @@ def _labels(edges: list[tuple[int, int, int]], earlier: int) -> list[tuple[bool,
     return [(s == earlier, c) for s, _, c in edges]
 
 
-def serialize(graph: StringGraph, rng: np.random.Generator | None = None, start: int | None = None) -> str:
-    """One string of the graph: a depth-first traversal from ``start`` (default: node 0, or a random node with
-    ``rng``), each node's unvisited neighbours in index order (or a random order with ``rng``)."""
+def serialize(graph: StringGraph, rng: np.random.Generator | None = None) -> str:
+    """One string of the graph: a depth-first traversal from node 0 (a random node with ``rng``), each node's
+    unvisited neighbours in index order (a random order with ``rng``); each further component likewise."""
     n = len(graph.names)
     bonds = _bonds(graph)
     neighbours = [[] for _ in range(n)]
@@ -83,9 +82,7 @@ def serialize(graph: StringGraph, rng: np.random.Generator | None = None, start:
         neighbours[a].append(b)
         neighbours[b].append(a)
     order = (lambda xs: [xs[k] for k in rng.permutation(len(xs))]) if rng is not None else sorted
-    starts = list(range(n)) if start is None else [start, *[k for k in range(n) if k != start]]
-    if rng is not None and start is None:
-        starts = order(starts)
+    starts = order(list(range(n)))
     visited, parts = [False] * n, []
     for root in starts:
         if not visited[root]:
