@@ -39,7 +39,7 @@ def sampled_categories(cfg: dict, run: Path, room_type: str, graphs: int, tmp: P
     g = run / "results" / "graphs" / "ingested"
     out = tmp / room_type
     out.mkdir(parents=True, exist_ok=True)
-    summary = sample_graphs.run(cfg, Files(model=run / "results" / "graph_model" / room_type / "model.pt",
+    summary = sample_graphs.run(cfg, Files(model=run / "results" / "graph_model" / room_type / "planit" / "model.pt",
                                            nodes=g / "nodes.parquet", edges=g / "edges.parquet", spec=None),
                                 Files(nodes=out / "nodes.parquet", edges=out / "edges.parquet", summary=out / "summary.json"),
                                 room_type=room_type, count=graphs)

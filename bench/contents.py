@@ -27,7 +27,7 @@ def sampled_categories(config: dict, room_type: str, count: int) -> tuple[list[l
     """Each sampled graph's object categories, and the sampling summary."""
     nodes, edges = RUN / "graphs/ingested/nodes.parquet", RUN / "graphs/ingested/edges.parquet"
     _, graphs = room_graphs(nodes, edges, room_type)
-    rows, _, summary = sample_room_type(config, RUN / f"graph_model/{room_type}/model.pt", graphs, nodes, edges,
+    rows, _, summary = sample_room_type(config, RUN / f"graph_model/{room_type}/planit/model.pt", graphs, nodes, edges,
                                         room_type, count=count, threads=2)
     rooms: dict = {}
     for r in rows:
@@ -39,7 +39,7 @@ def sampled_categories(config: dict, room_type: str, count: int) -> tuple[list[l
 def real_categories(room_type: str) -> tuple[list[list[str]], list[list[str]]]:
     """Object categories of the training graphs and of the held-out graphs (the graph model's split)."""
     _, graphs = room_graphs(RUN / "graphs/ingested/nodes.parquet", RUN / "graphs/ingested/edges.parquet", room_type)
-    saved, vocab, _ = load_model(RUN / f"graph_model/{room_type}/model.pt")
+    saved, vocab, _ = load_model(RUN / f"graph_model/{room_type}/planit/model.pt")
     held = set(saved["heldout_ids"])
     cats = lambda g: [vocab.node_classes[c] for c in g.node_class[g.n_arch:] if c >= len(ARCH)]  # noqa: E731
     return [cats(g) for g in graphs if g.room_id not in held], [cats(g) for g in graphs if g.room_id in held]

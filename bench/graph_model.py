@@ -5,7 +5,7 @@ run (graphs/s), and sampling time per graph, one graph at a time and batched.
         [--graphs-dir results/graphs/ingested]
 
 Reads the final graphs and the trained model of a pipeline run (make pipeline first). Training time to reach within 2% of the best
-held-out NLL is in each room type's results/graph_model/<type>/training.json (written by the pipeline).
+held-out NLL is in each room type's results/graph_model/<type>/planit/training.json (written by the pipeline).
 """
 from __future__ import annotations
 

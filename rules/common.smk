@@ -49,6 +49,7 @@ wildcard_constraints:
     keep="[0-9]+",
     net="cfcn|fcn",
     method="|".join(config["generation"]["methods"]),
+    generator="|".join(planit_methods.GRAPH_SOURCES),
     variant="|".join(v for v, s in config["instantiate"]["variants"].items() if s["graphs"] == "heldout"),
 
 
@@ -76,7 +77,7 @@ FINAL_SUMMARY = "results/graphs/{corpus}/final/summary-{shard}.json"
 GATHERED = "results/graphs/{corpus}/{table}.parquet"
 REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
-GRAPH_MODEL = "results/graph_model/{room_type}/{name}"
+GRAPH_MODEL = "results/graph_model/{room_type}/{generator}/{name}"  # a graph generator's model and graphs
 PLACEMENT = "results/placement/{room_type}/{net}/{name}"
 GENERATED = "results/generated/{room_type}/{method}/{name}"
 ABLATION = "results/generated/{room_type}/{variant}/{name}"  # Table 3's variants (held-out graphs)
@@ -93,12 +94,10 @@ RUNTIME = "results/runtime.csv"
 RUNTIME_HTML = "results/runtime.html"
 METHODS = config["generation"]["methods"]
 VARIANTS = config["instantiate"]["variants"]
+GENERATORS = planit_methods.graph_sources_of(METHODS)  # the graph generators the methods place graphs of
 TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldout"]
 # what placement training reads
 PLACEMENT_TRAIN_KEYS = ["preset", f"presets.{config['placement']['preset']}", "device"]
-# what training reads (sampling settings are not among them: changing them resamples without retraining)
-GRAPH_TRAIN_KEYS = ["preset", f"presets.{config['graph_model']['preset']}", "max_edges", "heldout_fraction", "validation_fraction",
-                    "device"]
 
 
 def keys(*dotted):
@@ -110,6 +109,17 @@ def keys(*dotted):
 def variant_keys(wildcards):
     """Params function: the keys a Table 3 ablation's search reads (its own variant's spec only)."""
     return keys(*search_keys(config, wildcards.variant))
+
+
+def generator_train_keys(wildcards):
+    """Params function: the keys a graph generator's training reads (sampling settings are not among them: changing
+    them resamples without retraining)."""
+    return keys(*planit_methods.graph_source(wildcards.generator).train_keys(config))
+
+
+def generator_sample_keys(wildcards):
+    """Params function: the keys a graph generator's sampling reads."""
+    return keys(*planit_methods.graph_source(wildcards.generator).sample_keys(config))
 
 
 def method_keys(wildcards):
@@ -206,7 +216,8 @@ def get_method_inputs(wildcards):
     m = planit_methods.get(wildcards.method)
     out = {}
     if m.graphs is not None:
-        out |= {t: GRAPH_MODEL.format(room_type=wildcards.room_type, name=f"sampled/{t}.parquet") for t in ("nodes", "edges")}
+        out |= {t: GRAPH_MODEL.format(room_type=wildcards.room_type, generator=m.graphs, name=f"sampled/{t}.parquet")
+                for t in ("nodes", "edges")}
     if m.model is not None:
         out["model"] = PLACEMENT.format(room_type=wildcards.room_type, net=m.model, name="model.pt")
     if m.reference is not None:
@@ -216,8 +227,9 @@ def get_method_inputs(wildcards):
 
 
 def spec_graph_model(wildcards):
-    """The graph model of a spec's room type."""
-    return GRAPH_MODEL.format(room_type=spec_room_type(SPEC_FILE.format(spec=wildcards.spec)), name="model.pt")
+    """The graph model of a spec's room type (PlanIT's: the generator that completes partial graphs)."""
+    return GRAPH_MODEL.format(room_type=spec_room_type(SPEC_FILE.format(spec=wildcards.spec)), generator="planit",
+                              name="model.pt")
 
 
 def spec_placement(wildcards):
@@ -249,7 +261,7 @@ def learned_outputs(wildcards):
     """Input function: the outputs of every learned room type (after the room_types checkpoint)."""
     types = graph_room_types()
     return [
-        *expand(GRAPH_MODEL, room_type=types, name=["metrics.json", "loss.png"]),
+        *expand(GRAPH_MODEL, room_type=types, generator=GENERATORS, name=["metrics.json", "loss.png"]),
         *expand(PLACEMENT, room_type=types, net="cfcn", name="loss.png"),
         *expand(GENERATED, room_type=types, method=METHODS, name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),

@@ -50,18 +50,19 @@ rule train_graph_model:
         model=GRAPH_MODEL.replace("{name}", "model.pt"),
         history=GRAPH_MODEL.replace("{name}", "history.csv"),
         curve=report(GRAPH_MODEL.replace("{name}", "loss.png"), caption="../report/graph_model_loss.rst",
-                     category="3. Training", subcategory="graph model", labels={"room type": "{room_type}"}),
+                     category="3. Training", subcategory="graph model",
+                     labels={"room type": "{room_type}", "generator": "{generator}"}),
         summary=GRAPH_MODEL.replace("{name}", "training.json"),
     params:
-        config=keys("seed", *(f"graph_model.{k}" for k in GRAPH_TRAIN_KEYS)),
+        config=generator_train_keys,
         io=stage_io("train_graph_model"),
     threads: 1  # more per job: set-threads in a profile
     resources:
-        gpu=1 if config["graph_model"]["device"] == "cuda" else 0,
+        gpu=lambda wildcards: int(config[planit_methods.graph_source(wildcards.generator).section]["device"] == "cuda"),
     log:
-        "logs/train_graph_model/{room_type}.log",
+        "logs/train_graph_model/{room_type}-{generator}.log",
     benchmark:
-        "benchmarks/train_graph_model/{room_type}.tsv"
+        "benchmarks/train_graph_model/{room_type}-{generator}.tsv"
     conda:
         ENV
     shell:
@@ -78,13 +79,13 @@ rule sample_graphs:
         edges=GRAPH_MODEL.replace("{name}", "sampled/edges.parquet"),
         summary=GRAPH_MODEL.replace("{name}", "sampled/summary.json"),
     params:
-        config=keys("seed", "graph_model.sample"),
+        config=generator_sample_keys,
         io=stage_io("sample_graphs"),
     threads: 1
     log:
-        "logs/sample_graphs/{room_type}.log",
+        "logs/sample_graphs/{room_type}-{generator}.log",
     benchmark:
-        "benchmarks/sample_graphs/{room_type}.tsv"
+        "benchmarks/sample_graphs/{room_type}-{generator}.tsv"
     conda:
         ENV
     shell:
@@ -105,9 +106,9 @@ rule graph_model_metrics:
         config=keys("seed", "source"),
         io=stage_io("graph_model_metrics"),
     log:
-        "logs/graph_model_metrics/{room_type}.log",
+        "logs/graph_model_metrics/{room_type}-{generator}.log",
     benchmark:
-        "benchmarks/graph_model_metrics/{room_type}.tsv"
+        "benchmarks/graph_model_metrics/{room_type}-{generator}.tsv"
     conda:
         ENV
     shell:

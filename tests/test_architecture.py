@@ -7,7 +7,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
 
 from conftest import ROOT
 
@@ -85,7 +84,7 @@ def _imports(path: Path) -> set[str]:
     return out
 
 
-TORCH_HOMES = ("pipeline.methods.planit", "pipeline.learning",
+TORCH_HOMES = ("pipeline.methods.planit", "pipeline.methods.strings", "pipeline.learning",
                "pipeline.evaluation.sca")
 
 

@@ -175,7 +175,7 @@ def test_a_search_setting_replaces_without_retraining(run_dir, tmp_path):
 def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
     res = run_dir / "results" / "graph_model"
     for room_type in LEARNED:
-        folder = res / room_type
+        folder = res / room_type / "planit"
         training = json.loads((folder / "training.json").read_text())
         assert training["epochs"] >= 1 and training["device"] == "cpu"
         assert (folder / "loss.png").stat().st_size > 1000
@@ -194,7 +194,29 @@ def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
         assert {"heldout_nll", "generated_vs_heldout", "floor_real_vs_heldout", "novelty", "uniqueness", "rules",
                 "goals"} <= set(metrics)
         assert metrics["heldout_nll"] == saved["heldout_nll"]
-        assert (run_dir / "logs" / "train_graph_model" / f"{room_type}.log").stat().st_size > 0
+        assert (run_dir / "logs" / "train_graph_model" / f"{room_type}-planit.log").stat().st_size > 0
+
+
+def test_the_string_vae_is_a_second_graph_generator_with_its_own_model_graphs_and_metrics(run_dir):
+    """The strings method: its generator's model, graphs and metrics under graph_model/<type>/strings/, scored by
+    the same graph metrics; its scenes placed by PlanIT's search from its own graphs, never PlanIT's."""
+    for room_type in LEARNED:
+        folder = run_dir / "results" / "graph_model" / room_type / "strings"
+        saved = checkpoint.load(folder / "model.pt", "strings_vae").record
+        assert saved["tokens"][:4] == ["<pad>", "<bos>", "<eos>", "<unk>"] and saved["preset"]["hidden"] == 32
+        history = pd.read_csv(folder / "history.csv")
+        assert len(history) == 30 and history["beta"].iloc[-1] == 1.0 and np.isfinite(history["validation_elbo"]).all()
+        summary = json.loads((folder / "sampled" / "summary.json").read_text())
+        assert summary["generator"] == "strings" and summary["written"] + summary["failed_after_budget"] == 10
+        assert sum(summary["rejections"].values()) >= summary["failed_after_budget"]
+        metrics = json.loads((folder / "metrics.json").read_text())
+        assert metrics["valid_before_rejection"] == summary["valid_before_rejection"]
+        assert metrics["heldout_nll"]["per_graph"] == saved["heldout_nll"]["per_graph"] > 0
+        placed = json.loads((run_dir / "results" / "generated" / room_type / "strings" / "summary.json").read_text())
+        assert placed["variant"] == "strings" and placed["scenes"] <= summary["written"]
+        scenes = pd.read_parquet(run_dir / "results" / "generated" / room_type / "strings" / "scenes.parquet")
+        sampled = pd.read_parquet(folder / "sampled" / "nodes.parquet")
+        assert set(scenes["scene_id"]) <= set(sampled["scene_id"])
 
 
 def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_path):
@@ -242,7 +264,7 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
     from pipeline.corpus.procedural_rules import RULES
 
     res = run_dir / "results"
-    sets = {"planit", "random_sampled", "unconditional_sampled", "retrieval", "real_heldout"}
+    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "retrieval", "real_heldout"}
     for room_type in LEARNED:
         m = json.loads((res / "eval" / room_type / "metrics.json").read_text())
         assert set(m["sets"]) == sets
@@ -296,7 +318,7 @@ def test_the_report_gathers_counts_tables_curves_evaluation_and_gallery(run_dir)
     html = _report(run_dir).read_text()
     for item in ("results/filter/rule_counts.html", "results/graphs/ingested/room_types.html",
                  "results/graphs/ingested/report/table1.html", "results/graphs/ingested/report/pruning.html",
-                 "results/graph_model/bedroom/loss.png", "results/placement/bedroom/cfcn/loss.png",
+                 "results/graph_model/bedroom/planit/loss.png", "results/placement/bedroom/cfcn/loss.png",
                  "results/generated/bedroom/table3.html", "results/eval/bedroom/metrics.html",
                  "results/eval/bedroom/power.png", "results/runtime.html"):
         assert f'"{item}": {{' in html, item

@@ -11,7 +11,8 @@ import pytest
 
 from pipeline.graphs.data import EDGE_CLASSES
 from pipeline.methods.strings.grammar import learn_grammar
-from pipeline.methods.strings.serialize import StringError, StringGraph, parse, serialize
+from pipeline.methods.strings.serialize import (Reader, StringError, StringGraph, arch_prefix, parse, serialize,
+                                               serialize_room, tokens)
 
 E = EDGE_CLASSES.index
 
@@ -79,6 +80,9 @@ def test_components_long_chains_and_digit_reuse_round_trip():
     ("[bed]{>sideways/adjacent}[lamp]", "'>sideways/adjacent' in bond {>sideways/adjacent} is not"),
     ("{>support}[lamp]", "token 0 '{>support}': a bond must follow an atom"),
     ("[bed] ! [lamp]", "character 6: '!' begins no token"),
+    ("[bed]{>support}@1", "token 2 '@1': atom 1 is not an earlier atom (this is atom 0)"),
+    ("[bed]@0", "token 1 '@0': a reference needs an atom and a bond before it"),
+    ("[bed]%1{>support}%1", "token 3 '%1': ring 1 closes on the atom that opened it"),
 ])
 def test_malformed_strings_name_the_token_and_the_fault(text, message):
     with pytest.raises(StringError, match=re.escape(message)):
@@ -109,3 +113,50 @@ def test_a_coarser_grammar_accepts_what_the_edge_grammar_rejects():
     assert not learn_grammar([bedroom()], "relation").valid(far) and learn_grammar([bedroom()], "neighbour").valid(far)
     with pytest.raises(ValueError, match="grammar detail 'coarse'"):
         learn_grammar([bedroom()], "coarse")
+
+
+def relabelled(graph: StringGraph, order: list[int]) -> set:
+    """The edges of ``graph`` with its nodes renamed by ``order`` (node k -> order[k]), with their names."""
+    return {(order[a], order[b], c, graph.names[a], graph.names[b]) for a, b, c in graph.edges.tolist()}
+
+
+def test_a_room_string_starts_with_its_architecture_and_reads_back_to_the_same_nodes():
+    """The prefix is the architecture's own string, the same for every order; the objects refer to its atoms, so
+    the parsed graph's first atoms are the architecture's nodes in the prefix's order: the same graph, node for
+    node, not only up to isomorphism."""
+    g, n_arch = bedroom(), 4
+    prefix, order = arch_prefix(g, n_arch)
+    assert serialize_room(g, n_arch) == prefix + ".[bed]{>front/adjacent}@0{>right/adjacent}[nightstand]" \
+                                              "{>front/adjacent}@0{>support}[table_lamp]"
+    rng = np.random.default_rng(3)
+    texts = {serialize_room(g, n_arch, rng) for _ in range(30)}
+    assert len(texts) > 3 and all(t.startswith(prefix + ".") for t in texts)
+    for text in texts:
+        back = parse(text)
+        objects = [k for k in range(n_arch, len(back.names))]
+        assert sorted(back.names[n_arch:]) == sorted(g.names[n_arch:]) and back.names[:n_arch] == g.names[:n_arch]
+        assert isomorphic(back, g)
+        # architecture atoms map back exactly; objects by their (unique) names
+        to_g = {**dict(enumerate(order)), **{k: g.names.index(back.names[k]) for k in objects}}
+        assert relabelled(back, [to_g[k] for k in range(len(back.names))]) == relabelled(g, list(range(len(g.names))))
+
+
+def test_the_parsers_fault_is_what_a_decoder_masks():
+    """Reader.fault, asked token by token, allows exactly the tokens parse takes: every prefix of a valid string
+    allows its next token, and the end only where parse accepts the string."""
+    text = serialize_room(bedroom(), 4, np.random.default_rng(0))
+    reader = Reader()
+    toks = tokens(text)
+    for i, tok in enumerate(toks):
+        assert reader.fault(tok) is None
+        assert (reader.end_fault() is None) == _parses("".join(toks[:i]))
+        reader.read(tok, i)
+    assert reader.end_fault() is None and reader.fault("[bed]") is not None  # an atom after an atom
+
+
+def _parses(text: str) -> bool:
+    try:
+        parse(text)
+        return True
+    except StringError:
+        return False

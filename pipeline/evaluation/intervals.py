@@ -26,9 +26,11 @@ def figures(rows: pd.DataFrame, real: pd.DataFrame, eps: float, extra: list[str]
     cats = [c for c in rows.columns if c.startswith(CATEGORY)]
     objects = max(float(rows["objects"].sum()), 1.0)
     scenes = len(rows)
+    none = float("nan")  # a set with no room has no distribution to compare
     out = {
-        "category_kl": category_kl_counts(real[cats].to_numpy(float).sum(0), rows[cats].to_numpy(float).sum(0), eps),
-        "count_distance": count_distance(real["objects"].tolist(), rows["objects"].tolist()),
+        "category_kl": category_kl_counts(real[cats].to_numpy(float).sum(0), rows[cats].to_numpy(float).sum(0), eps)
+        if scenes else none,
+        "count_distance": count_distance(real["objects"].tolist(), rows["objects"].tolist()) if scenes else none,
         "object_collision_rate": float(rows["colliding_objects"].sum()) / objects,
         "scene_collision_rate": float((rows["colliding_objects"] > 0).mean()) if scenes else float("nan"),
         "out_of_bounds_rate": float(rows["out_of_bounds"].sum()) / objects,

@@ -26,6 +26,17 @@ def read_split(path: Path) -> dict[str, str]:
     return {r["room_id"]: r["split"] for r in rows}
 
 
+def split_graphs(graphs: list[data.Graph], split: dict[str, str], room_type: str) -> dict[str, list[data.Graph]]:
+    """The room type's graphs in each part of its split (``fit``, ``validation``, ``heldout``, sorted by room id); an
+    :class:`InputError` when a part is empty (a learner needs all three)."""
+    by_id = {g.room_id: g for g in graphs}
+    parts = {s: [by_id[r] for r in sorted(by_id) if split.get(r) == s] for s in ("fit", "validation", "heldout")}
+    if not all(parts.values()):
+        raise InputError(f"room type '{room_type}' has {len(graphs)} graph(s); training needs 3 or more "
+                         "(fitted, validation and held-out)")
+    return parts
+
+
 def split_ids(split: dict[str, str], *names: str) -> list[str]:
     """The sorted room ids in any of the named parts of a split."""
     return sorted(r for r, s in split.items() if s in names)

@@ -4,15 +4,15 @@
 from __future__ import annotations
 
 import importlib
+from types import SimpleNamespace
 
 from ..errors import InputError
-from .interface import Corpus, Generated, GraphGenerator, LayoutGenerator, Method, Scene, Task
+from .interface import Corpus, Generated, GraphGenerator, GraphSource, LayoutGenerator, Method, Scene, Task
 
-__all__ = ["Corpus", "Generated", "GraphGenerator", "LayoutGenerator", "Method", "Scene", "Task", "register", "get",
-           "names", "load_plugins", "layout_of", "graph_generator"]
+__all__ = ["Corpus", "Generated", "GraphGenerator", "GraphSource", "LayoutGenerator", "Method", "Scene", "Task", "register",
+           "get", "names", "load_plugins", "layout_of", "graph_generator", "graph_source", "graph_sources_of"]
 
 _METHODS: dict[str, Method] = {}
-GRAPH_GENERATORS = {"planit": "pipeline.methods.planit.graph_model.generator:GraphModel"}
 
 
 def register(method: Method) -> Method:
@@ -54,13 +54,24 @@ def layout_of(method: Method, config: dict) -> LayoutGenerator:
     return _load(method.layout)(config, method.name)
 
 
+def graph_source(name: str) -> GraphSource:
+    if name not in GRAPH_SOURCES:
+        raise InputError(f"no graph generator '{name}' (known: {', '.join(sorted(GRAPH_SOURCES))})")
+    return GRAPH_SOURCES[name]
+
+
 def graph_generator(name: str) -> GraphGenerator:
-    if name not in GRAPH_GENERATORS:
-        raise InputError(f"no graph generator '{name}' (known: {', '.join(sorted(GRAPH_GENERATORS))})")
-    return _load(GRAPH_GENERATORS[name])()
+    """The graph generator registered as ``name``: its ``fit`` and ``sample`` functions, imported."""
+    src = graph_source(name)
+    return SimpleNamespace(fit=_load(src.fit), sample=_load(src.sample))
 
 
-from .builtin import BUILTIN  # noqa: E402
+def graph_sources_of(method_names: list[str]) -> list[str]:
+    """The graph generators the named methods place graphs of, in their order."""
+    return list(dict.fromkeys(get(m).graphs for m in method_names if get(m).graphs is not None))
+
+
+from .builtin import BUILTIN, GRAPH_SOURCES  # noqa: E402
 
 for _m in BUILTIN:
     register(_m)

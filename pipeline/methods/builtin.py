@@ -1,7 +1,25 @@
-"""The built-in methods: PlanIT and its baselines (instantiate.variants of sampled graphs), and retrieval."""
+"""The built-in graph generators (PlanIT's graph model, the string VAE) and methods: PlanIT and its baselines
+(instantiate.variants of sampled graphs), the string VAE's graphs placed by PlanIT's search, and retrieval."""
 from __future__ import annotations
 
-from .interface import Method
+from .interface import GraphSource, Method
+
+
+def _preset_keys(section: str, *more: str):
+    """A learner's training keys: its preset's name and sizes, its device and ``more``."""
+    return lambda config: ["seed", f"{section}.preset", f"{section}.presets.{config[section]['preset']}",
+                           f"{section}.device", *(f"{section}.{k}" for k in more)]
+
+
+GRAPH_SOURCES = {s.name: s for s in [
+    GraphSource("planit", "pipeline.methods.planit.graph_model.fit:fit_room_type",
+                "pipeline.methods.planit.graph_model.sample:sample_room_type", "graph_model", "graph_model",
+                _preset_keys("graph_model", "max_edges", "heldout_fraction", "validation_fraction"),
+                lambda config: ["seed", "graph_model.sample"]),
+    GraphSource("strings", "pipeline.methods.strings.fit:fit_room_type", "pipeline.methods.strings.rooms:sample_room_type",
+                "strings_vae", "strings",
+                _preset_keys("strings"), lambda config: ["seed", "strings.sample", "graph_model.sample.contents"]),
+]}
 
 
 def search_keys(config: dict, name: str) -> list[str]:
@@ -17,8 +35,8 @@ def search_scenes(config: dict, name: str) -> int:
     return min(ic["scenes"], ic["variants"][name].get("scenes", ic["scenes"]))
 
 
-def _search(name: str, net: str, description: str) -> Method:
-    return Method(name, "pipeline.methods.planit.layout:PlanitLayout", graphs="planit", model=net, keys=search_keys,
+def _search(name: str, net: str, description: str, graphs: str = "planit") -> Method:
+    return Method(name, "pipeline.methods.planit.layout:PlanitLayout", graphs=graphs, model=net, keys=search_keys,
                   scenes=search_scenes, description=description)
 
 
@@ -26,6 +44,8 @@ BUILTIN = [
     _search("planit", "cfcn", "PlanIT: the graph model's sampled graphs placed by the search with the CFCN"),
     _search("random_sampled", "cfcn", "the sampled graphs' objects at uniform random locations (collision-checked)"),
     _search("unconditional_sampled", "fcn", "the sampled graphs placed with the location network without FiLM"),
+    _search("strings", "cfcn", "the string VAE's sampled graphs (Kalojanov et al.) placed by PlanIT's search with the "
+            "CFCN", graphs="strings"),
     Method("retrieval", "pipeline.methods.retrieval:Retrieval", reference="planit",
            keys=lambda config, name: ["evaluate.render"],
            description="each of PlanIT's rooms replaced by its nearest training room (the memorisation floor)"),

@@ -109,12 +109,28 @@ class GraphGenerator(Protocol):
 
 
 @dataclass(frozen=True)
+class GraphSource:
+    """A registered graph generator: ``fit`` and ``sample`` (``"module:function"``, imported when it runs) are the
+    two functions of :class:`GraphGenerator`; ``kind`` is its checkpoint's kind, ``section`` its config section;
+    ``train_keys(config)`` and ``sample_keys(config)``
+    the dotted config keys its ``train_graph_model`` and ``sample_graphs`` jobs read (changing one reruns exactly
+    those jobs of this generator)."""
+    name: str
+    fit: str
+    sample: str
+    kind: str
+    section: str
+    train_keys: Callable[[dict], list[str]]
+    sample_keys: Callable[[dict], list[str]]
+
+
+@dataclass(frozen=True)
 class Method:
     """A named generator: a layout generator (``layout``: ``"module:factory"``, imported when the method runs;
     ``factory(config, name)`` returns the :class:`LayoutGenerator`) and the inputs its rule gives it."""
     name: str
     layout: str
-    graphs: str | None = None  # the graph generator whose sampled graphs it places ("planit"), or None
+    graphs: str | None = None  # the graph generator whose sampled graphs it places ("planit", "strings"), or None
     model: str | None = None  # the placement networks it reads ("cfcn" | "fcn"), or None
     reference: str | None = None  # the method whose rooms it reads, or None
     keys: Callable[[dict, str], list[str]] = lambda config, name: ["seed"]  # the config keys it reads

@@ -9,6 +9,7 @@ from ..stage import Param, Stage, many, one
 SHARD = Param("shard", int, help="shard index")
 ROOM_TYPE = Param("room_type", help="room type")
 METHOD = Param("method", help="a generation method (generation.methods)")
+GENERATOR = Param("generator", default="planit", help="a registered graph generator (planit, strings)")
 CORPUS = (one("rooms", "the shard's rooms"), one("architecture"), one("objects"), one("models"))
 CORPUS_SHARDS = (many("rooms", "the kept rooms, one per shard"), many("architecture"), many("objects"), many("models"))
 GRAPHS = (one("nodes", "final nodes"), one("edges", "final edges"))
@@ -64,11 +65,12 @@ _ALL = [
     Stage("split_rooms", "Split one room type's rooms into fit, validation and held-out rooms (seeded).",
           inputs=(one("nodes", "final nodes"),), outputs=(one("split"),), params=(ROOM_TYPE,)),
     Stage("train_graph_model", "Train the graph generative model of one room type (resumes from the checkpoint "
-          "beside --out-model).", inputs=(*GRAPHS, SPLIT), outputs=TRAINING, params=(ROOM_TYPE,), threads=True),
+          "beside --out-model).", inputs=(*GRAPHS, SPLIT), outputs=TRAINING, params=(ROOM_TYPE, GENERATOR), threads=True),
     Stage("sample_graphs", "Sample relation graphs of a room type, from scratch or completing --spec.",
           inputs=(one("model", "the graph model"), *GRAPHS, one("spec", "complete this partial graph (YAML)", True)),
           outputs=(one("nodes"), one("edges"), one("summary")),
-          params=(ROOM_TYPE, Param("count", int, None, "graphs (default graph_model.sample.graphs)")), threads=True),
+          params=(ROOM_TYPE, Param("count", int, None, "graphs (default: the generator's sample.graphs)"), GENERATOR),
+          threads=True),
     Stage("complete_graphs", "Complete a partial graph (a YAML spec) with its room type's graph model.",
           inputs=(one("model", "the spec's room type's graph model"), *GRAPHS, one("spec_file", "the partial graph (YAML)")),
           outputs=(one("nodes"), one("edges"), one("summary")),
@@ -77,7 +79,7 @@ _ALL = [
     Stage("graph_model_metrics", "Evaluate a room type's graph model (held-out NLL; generated vs held-out graphs "
           "beside the sampling floor).", inputs=(one("model"), *GRAPHS, one("gen_nodes"), one("gen_edges"),
                                                  one("sample_summary")),
-          outputs=(one("metrics"),), params=(ROOM_TYPE,)),
+          outputs=(one("metrics"),), params=(ROOM_TYPE, GENERATOR)),
     Stage("train_placement", "Train the location and orientation networks of one room type (resumes from the "
           "checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT), outputs=TRAINING,
           params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned) or fcn (the unconditional ablation)")),

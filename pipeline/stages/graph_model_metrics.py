@@ -1,4 +1,5 @@
-"""Evaluate one room type's graph model: its sampled graphs against the held-out real graphs (metrics.json)."""
+"""Evaluate one room type's graph generator (PlanIT's graph model or another): its sampled graphs against the
+held-out real graphs (metrics.json)."""
 from __future__ import annotations
 
 import json
@@ -14,11 +15,11 @@ from ..stage import Files
 log = logging.getLogger("planit.graph_model_metrics")
 
 
-def run(config: dict, inp: Files, out: Files, room_type: str) -> dict:
+def run(config: dict, inp: Files, out: Files, room_type: str, generator: str = "planit") -> dict:
     from ..learning import checkpoint
-    from ..methods.planit.graph_model.train import KIND
+    from ..methods import graph_source
 
-    saved = checkpoint.load(inp.model, KIND).record
+    saved = checkpoint.load(inp.model, graph_source(generator).kind).record
     vocab = graph_data.Vocab(tuple(saved["categories"]))
     _, real = room_graphs(inp.nodes, inp.edges, room_type)
     by_id = {g.room_id: g for g in real}

@@ -3,7 +3,6 @@ their dataset-wide count, category sizes over every raw node."""
 from __future__ import annotations
 
 import logging
-from pathlib import Path
 
 import pyarrow as pa
 

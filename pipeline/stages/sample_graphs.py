@@ -1,4 +1,4 @@
-"""Sample relation graphs of one room type from its trained graph model, in held-out rooms' architectures; invalid
+"""Sample relation graphs of one room type from a trained graph generator, in held-out rooms' architectures; invalid
 graphs are resampled (a budget), never written."""
 from __future__ import annotations
 
@@ -7,9 +7,10 @@ from ..methods import graph_generator
 from ..stage import Files
 
 
-def run(config: dict, inp: Files, out: Files, room_type: str, count: int | None = None, threads: int = 1) -> dict:
+def run(config: dict, inp: Files, out: Files, room_type: str, count: int | None = None, generator: str = "planit",
+        threads: int = 1) -> dict:
     _, graphs = room_graphs(inp.nodes, inp.edges, room_type)
-    rows_n, rows_e, summary = graph_generator("planit").sample(config, inp.model, graphs, inp.nodes, inp.edges,
-                                                               room_type, None, count, threads)
+    rows_n, rows_e, summary = graph_generator(generator).sample(config, inp.model, graphs, inp.nodes, inp.edges,
+                                                                room_type, inp.spec, count, threads)
     write_graphs(out, rows_n, rows_e, summary)
     return summary

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import logging
 from collections import Counter
-from pathlib import Path
 
 from .. import tables
 from ..scoring import extraction_counts, extraction_scores

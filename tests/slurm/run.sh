@@ -105,7 +105,7 @@ log "Slurm is up: $(sinfo -h -o '%P %D %t %c cpus %m MB')"
 export PATH="$BIN:$PATH"
 TARGETS=(results/graphs/ingested/report/table1.csv results/metrics/ingested/extraction.json
          results/metrics/ingested/superstructures.json results/filter/report.parquet results/ingest/drops.parquet
-         results/graph_model/bedroom/metrics.json results/generated/bedroom/planit/summary.json)
+         results/graph_model/bedroom/planit/metrics.json results/generated/bedroom/planit/summary.json)
 run() {  # run <name> <extra snakemake args...>
   local dir="$STATE/$1"; shift
   mkdir -p "$dir"

@@ -8,7 +8,7 @@ the neighbour's class). The finer, the more held-out real graphs it rejects (doc
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...graphs.data import EDGE_CLASSES
 from .serialize import StringGraph
@@ -41,6 +41,7 @@ class Grammar:
     """Node class -> bond -> the most of that bond one node of the class held in a training graph."""
     most: dict[str, dict[Bond, int]]
     detail: str = "edge"
+    _neighbours: dict = field(default_factory=dict, compare=False, repr=False)
 
     def violations(self, graph: StringGraph) -> list[str]:
         """What a graph does that no training graph did: an unseen class, an unseen bond, more of a bond than seen."""
@@ -59,6 +60,35 @@ class Grammar:
 
     def valid(self, graph: StringGraph) -> bool:
         return not self.violations(graph)
+
+    def neighbours(self, name: str) -> set[str]:
+        """The classes a node of class ``name`` was seen bonded to."""
+        if name not in self._neighbours:
+            self._neighbours[name] = {b[2] for b in self.most.get(name, {})}
+        return self._neighbours[name]
+
+    def fits(self, name: str, held: Counter, added: list[Bond]) -> bool:
+        """Whether a node of class ``name`` holding the bonds ``held`` may take the bonds ``added`` too."""
+        seen = self.most.get(name)
+        if seen is None:
+            return False
+        more = Counter(added)
+        return all(seen.get(b, 0) >= held[b] + k for b, k in more.items())
+
+    def bond(self, out: bool, edge_class: int, neighbour: str) -> Bond:
+        """A bond at this grammar's detail: ``out`` of the node (or into it), its edge class, the neighbour's class."""
+        return (">" if out else "<", relation(edge_class, self.detail), neighbour)
+
+
+def node_bonds(names, edges, node: int, grammar: Grammar) -> Counter:
+    """The bonds ``node`` holds among ``edges`` (source, target, class) at the grammar's detail."""
+    out = Counter()
+    for s, t, c in edges:
+        if s == node:
+            out[grammar.bond(True, c, names[t])] += 1
+        if t == node:
+            out[grammar.bond(False, c, names[s])] += 1
+    return out
 
 
 def learn_grammar(graphs: list[StringGraph], detail: str = "edge") -> Grammar:

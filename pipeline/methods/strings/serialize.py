@@ -9,7 +9,11 @@ A string is a list of tokens:
 - ``(`` and ``)`` around every branch but the last of an atom;
 - a *ring closure* ``%k``: after an atom, it opens ring ``k`` there; a later ``{bond}%k`` after another atom closes
   it with that bond (the edges of a cycle the depth-first traversal did not walk, as the wall loop's);
-- ``.`` starts another connected component.
+- ``.`` starts another connected component;
+- a *reference* ``{bond}@k`` after an atom: that bond between it and the string's ``k``-th atom (0-based), written
+  earlier. A room's string (:func:`serialize_room`) starts with its architecture's own string and refers to those
+  atoms from the objects' components, so a sequence model can be given the architecture and write the rest
+  (issue 31: conditioned on the room's walls and openings).
 
 A graph has many strings, one per depth-first order (a start node and an order of each node's neighbours):
 :func:`serialize` draws them from a generator, as the paper trains on several strings per shape. :func:`parse`
@@ -26,7 +30,7 @@ import numpy as np
 from ...errors import PlanitError
 from ...graphs.data import EDGE_CLASSES, Graph, Vocab
 
-TOKEN = re.compile(r"\[[^\[\]{}()%.]+\]|\{[^{}]*\}|%\d+|[().]")
+TOKEN = re.compile(r"\[[^\[\]{}()%@.]+\]|\{[^{}]*\}|%\d+|@\d+|[().]")
 
 
 class StringError(PlanitError):
@@ -74,6 +78,12 @@ def _labels(edges: list[tuple[int, int, int]], earlier: int) -> list[tuple[bool,
 def serialize(graph: StringGraph, rng: np.random.Generator | None = None) -> str:
     """One string of the graph: a depth-first traversal from node 0 (a random node with ``rng``), each node's
     unvisited neighbours in index order (a random order with ``rng``); each further component likewise."""
+    return _serialize(graph, rng)[0]
+
+
+def _serialize(graph: StringGraph, rng: np.random.Generator | None, after: dict | None = None) -> tuple[str, list[int]]:
+    """:func:`serialize`'s string and its atoms' nodes in the string's order; ``after``: node -> tokens written
+    right after its atom (its references)."""
     n = len(graph.names)
     bonds = _bonds(graph)
     neighbours = [[] for _ in range(n)]
@@ -83,16 +93,50 @@ def serialize(graph: StringGraph, rng: np.random.Generator | None = None) -> str
         neighbours[b].append(a)
     order = (lambda xs: [xs[k] for k in rng.permutation(len(xs))]) if rng is not None else sorted
     starts = order(list(range(n)))
-    visited, parts = [False] * n, []
+    visited, parts, atoms = [False] * n, [], []
     for root in starts:
         if not visited[root]:
-            parts.append(_component(root, graph, bonds, [order(nb) for nb in neighbours], visited))
-    return ".".join(parts)
+            text, seen = _component(root, graph, bonds, [order(nb) for nb in neighbours], visited, after or {})
+            parts.append(text)
+            atoms += seen
+    return ".".join(parts), atoms
 
 
-def _component(root: int, graph: StringGraph, bonds: dict, neighbours: list[list[int]], visited: list[bool]) -> str:
-    """The string of ``root``'s component: a first pass finds the traversal tree and the ring (back) edges, a second
-    writes atoms, ring digits and branches."""
+def serialize_room(graph: StringGraph, n_arch: int, rng: np.random.Generator | None = None) -> str:
+    """A room's string, conditioned on its architecture: :func:`arch_prefix` (nodes ``0 .. n_arch - 1``), then
+    ``.`` and the objects' components (random orders with ``rng``), each object's bonds to the architecture written
+    after its atom as references ``{bond}@k``."""
+    prefix, arch_order = arch_prefix(graph, n_arch)
+    at = {node: k for k, node in enumerate(arch_order)}
+    objects = _subgraph(graph, range(n_arch, len(graph.names)))
+    refs: dict[int, list[str]] = {}
+    for pair, edges in sorted(_bonds(graph).items(), key=lambda kv: sorted(kv[0])):
+        a, o = sorted(pair)
+        if a < n_arch <= o:
+            refs.setdefault(o - n_arch, []).append(bond_token(_labels(edges, a)) + f"@{at[a]}")
+    body = _serialize(objects, rng, refs)[0]
+    return prefix + ("." + body if body else "")
+
+
+def arch_prefix(graph: StringGraph, n_arch: int) -> tuple[str, list[int]]:
+    """The string of the architecture (nodes ``0 .. n_arch - 1`` and the edges among them, one fixed order) and its
+    atoms' nodes in order: the ``k``-th atom of a room string is node ``order[k]`` for ``k < n_arch``."""
+    return _serialize(_subgraph(graph, range(n_arch)), None)
+
+
+def _subgraph(graph: StringGraph, nodes: range) -> StringGraph:
+    """The nodes ``nodes`` (a range) and the edges among them, renumbered from 0."""
+    e = graph.edges
+    inside = (e[:, 0] >= nodes.start) & (e[:, 0] < nodes.stop) & (e[:, 1] >= nodes.start) & (e[:, 1] < nodes.stop)
+    kept = e[inside].copy()
+    kept[:, :2] -= nodes.start
+    return StringGraph(graph.names[nodes.start:nodes.stop], kept)
+
+
+def _component(root: int, graph: StringGraph, bonds: dict, neighbours: list[list[int]], visited: list[bool],
+               after: dict) -> tuple[str, list[int]]:
+    """The string of ``root``'s component and its nodes in the string's order: a first pass finds the traversal
+    tree and the ring (back) edges, a second writes atoms, ring digits and branches."""
     children: dict[int, list[int]] = {}
     rings: list[tuple[int, int]] = []  # (opener: earlier in the string, closer)
     seen_at: dict[int, int] = {}  # node -> place in the string (the pops follow the tree's pre-order)
@@ -113,10 +157,10 @@ def _component(root: int, graph: StringGraph, bonds: dict, neighbours: list[list
         if pair not in tree and all(k in seen_at for k in pair):
             a, b = sorted(pair, key=seen_at.get)
             rings.append((a, b))
-    return _write(root, graph, bonds, children, rings, seen_at)
+    return _write(root, graph, bonds, children, rings, seen_at, after), sorted(seen_at, key=seen_at.get)
 
 
-def _write(root: int, graph: StringGraph, bonds: dict, children: dict, rings: list, seen_at: dict) -> str:
+def _write(root: int, graph: StringGraph, bonds: dict, children: dict, rings: list, seen_at: dict, after: dict) -> str:
     """Emit the component in the traversal's order (iteratively: long chains do not hit the recursion limit). At an
     atom, the rings it closes come first (each with its bond), then the rings it opens, each on the smallest digit
     not in use."""
@@ -139,6 +183,7 @@ def _write(root: int, graph: StringGraph, bonds: dict, children: dict, rings: li
             used = set(digit_of.values())
             digit_of[(value, b)] = next(k for k in range(1, len(used) + 2) if k not in used)
             out.append(f"%{digit_of[(value, b)]}")
+        out += after.get(value, [])
         kids = children.get(value, [])
         for i in range(len(kids) - 1, -1, -1):
             branch = i < len(kids) - 1
@@ -148,17 +193,20 @@ def _write(root: int, graph: StringGraph, bonds: dict, children: dict, rings: li
 
 
 def parse(text: str) -> StringGraph:
-    """The graph of a string written by :func:`serialize` (or generated in its grammar). Raises
-    :class:`StringError` naming the first malformed token: an unknown edge class, a bond with no atom after it, an
-    unclosed branch or ring, a ring closed without a bond, a ``)`` with no ``(``."""
-    reader = _Reader()
+    """The graph of a string written by :func:`serialize` or :func:`serialize_room` (or generated in their grammar).
+    Raises :class:`StringError` naming the first malformed token: an unknown edge class, a bond with no atom after
+    it, an unclosed branch or ring, a ring closed without a bond, a ``)`` with no ``(``, a reference to no earlier
+    atom."""
+    reader = Reader()
     for i, tok in enumerate(tokens(text)):
         reader.read(tok, i)
     return reader.finish()
 
 
-class _Reader:
-    """The parser's state: atoms and edges so far, the current atom, a pending bond, open branches and rings."""
+class Reader:
+    """The parser's state: atoms and edges so far, the current atom, a pending bond, open branches and rings.
+    :meth:`fault` says whether a token may come next (a decoder masks the tokens that may not), :meth:`read` takes
+    it."""
 
     def __init__(self):
         self.names: list[str] = []
@@ -168,71 +216,93 @@ class _Reader:
         self.branches: list[int] = []
         self.rings: dict[int, tuple[int, int]] = {}  # digit -> (opening atom, token index)
 
-    def read(self, tok: str, i: int) -> None:
-        where = f"token {i} '{tok}'"
+    def fault(self, tok: str) -> str | None:
+        """Why ``tok`` may not come next (None: it may)."""
+        atom, bonded = self.current is not None, self.bond is not None
         if tok.startswith("["):
-            self.atom(tok[1:-1], where)
+            return "an atom after an atom needs a bond between them" if atom and not bonded else None
+        if tok.startswith("{"):
+            return "a bond must follow an atom" if not atom or bonded else label_fault(tok)
+        if tok.startswith("%"):
+            k = int(tok[1:])
+            if not atom:
+                return "a ring digit must follow an atom"
+            if k not in self.rings:
+                return f"ring {k} is opened with a bond (a bond goes where it closes)" if bonded else None
+            if not bonded:
+                return f"ring {k} is closed without a bond"
+            return f"ring {k} closes on the atom that opened it" if self.rings[k][0] == self.current else None
+        if tok.startswith("@"):
+            if not atom or not bonded:
+                return "a reference needs an atom and a bond before it"
+            return f"atom {tok[1:]} is not an earlier atom (this is atom {self.current})" if int(tok[1:]) >= self.current else None
+        if tok == "(":
+            return "a branch must follow an atom" if not atom or bonded else None
+        if tok == ")":
+            return "no open branch" if not self.branches else "a bond with no atom after it" if bonded else None
+        return "'.' inside a branch or after a bond" if bonded or self.branches else None
+
+    def read(self, tok: str, i: int) -> None:
+        """Take token ``i``; a :class:`StringError` names it when it may not come here."""
+        fault = self.fault(tok)
+        if fault is not None:
+            raise StringError(f"token {i} '{tok}': {fault}")
+        if tok.startswith("["):
+            self.names.append(tok[1:-1])
+            if self.bond is not None:
+                self.edges += _edges(self.bond, self.current, len(self.names) - 1)
+            self.current, self.bond = len(self.names) - 1, None
         elif tok.startswith("{"):
-            if self.current is None or self.bond is not None:
-                raise StringError(f"{where}: a bond must follow an atom")
             self.bond = tok
         elif tok.startswith("%"):
-            self.ring(int(tok[1:]), i, where)
+            k = int(tok[1:])
+            if k in self.rings:
+                self.edges += _edges(self.bond, self.rings.pop(k)[0], self.current)
+            else:
+                self.rings[k] = (self.current, i)
+            self.bond = None
+        elif tok.startswith("@"):
+            self.edges += _edges(self.bond, int(tok[1:]), self.current)
+            self.bond = None
         elif tok == "(":
-            if self.current is None or self.bond is not None:
-                raise StringError(f"{where}: a branch must follow an atom")
             self.branches.append(self.current)
         elif tok == ")":
-            if not self.branches or self.bond is not None:
-                raise StringError(f"{where}: {'no open branch' if not self.branches else 'a bond with no atom after it'}")
             self.current = self.branches.pop()
-        else:  # "."
-            if self.bond is not None or self.branches:
-                raise StringError(f"{where}: '.' inside a branch or after a bond")
+        else:
             self.current = None
 
-    def atom(self, name: str, where: str) -> None:
-        self.names.append(name)
+    def end_fault(self) -> str | None:
+        """Why the string may not end here (None: it may)."""
         if self.bond is not None:
-            self.edges += _edges(self.bond, self.current, len(self.names) - 1, where)
-        elif self.current is not None:
-            raise StringError(f"{where}: an atom after an atom needs a bond between them")
-        self.current, self.bond = len(self.names) - 1, None
-
-    def ring(self, k: int, i: int, where: str) -> None:
-        """Open ring ``k`` at the current atom, or close it there with the pending bond."""
-        if self.current is None:
-            raise StringError(f"{where}: a ring digit must follow an atom")
-        if k in self.rings:
-            opener, _ = self.rings.pop(k)
-            if self.bond is None:
-                raise StringError(f"{where}: ring {k} is closed without a bond")
-            self.edges += _edges(self.bond, opener, self.current, where)
-        elif self.bond is not None:
-            raise StringError(f"{where}: ring {k} is opened with a bond (a bond goes where it closes)")
-        else:
-            self.rings[k] = (self.current, i)
-        self.bond = None
-
-    def finish(self) -> StringGraph:
-        if self.bond is not None:
-            raise StringError("the string ends with a bond and no atom after it")
+            return "the string ends with a bond and no atom after it"
         if self.branches:
-            raise StringError(f"{len(self.branches)} branch(es) not closed at the end of the string")
+            return f"{len(self.branches)} branch(es) not closed at the end of the string"
         if self.rings:
             k, (_, i) = next(iter(self.rings.items()))
-            raise StringError(f"ring {k} opened at token {i} is never closed")
+            return f"ring {k} opened at token {i} is never closed"
+        return None
+
+    def finish(self) -> StringGraph:
+        fault = self.end_fault()
+        if fault is not None:
+            raise StringError(fault)
         return StringGraph(tuple(self.names), np.array(self.edges, np.int64).reshape(-1, 3))
 
 
-def _edges(bond: str, earlier: int, later: int, where: str) -> list[tuple[int, int, int]]:
-    """The edges a bond token gives between two atoms."""
+def label_fault(bond: str) -> str | None:
+    """Why a bond token's labels are malformed (None: each is ``>`` or ``<`` and an edge class)."""
+    for label in filter(None, bond[1:-1].split("|")):
+        if label[0] not in "<>" or label[1:] not in EDGE_CLASSES:
+            return f"'{label}' in bond {bond} is not '>' or '<' and an edge class"
+    return None
+
+
+def _edges(bond: str, earlier: int, later: int) -> list[tuple[int, int, int]]:
+    """The edges a (well-formed) bond token gives between two atoms."""
     out = []
     for label in filter(None, bond[1:-1].split("|")):
-        arrow, name = label[0], label[1:]
-        if arrow not in "<>" or name not in EDGE_CLASSES:
-            raise StringError(f"{where}: '{label}' in bond {bond} is not '>' or '<' and an edge class")
-        out.append((earlier, later, EDGE_CLASSES.index(name)) if arrow == ">" else (later, earlier, EDGE_CLASSES.index(name)))
+        cls = EDGE_CLASSES.index(label[1:])
+        out.append((earlier, later, cls) if label[0] == ">" else (later, earlier, cls))
     return out
 
 

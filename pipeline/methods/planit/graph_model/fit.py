@@ -9,9 +9,9 @@ import pandas as pd
 import torch
 
 from ....config import config_hash
-from ....errors import InputError
 from ....graphs import checks as graph_checks
 from ....graphs.data import Graph, Vocab
+from ....graphs.files import split_graphs
 from ....learning.checkpoint import Checkpoint
 from ....learning.device import pick_device
 from ....learning.fitted import Fitted
@@ -28,16 +28,13 @@ def fit_room_type(config: dict, vocab: Vocab, graphs: list[Graph], split: dict[s
     gm = config["graph_model"]
     preset = gm["presets"][gm["preset"]]
     torch.set_num_threads(threads)
-    by_id = {g.room_id: g for g in graphs}
-    ids = {s: sorted(r for r in by_id if split.get(r) == s) for s in ("fit", "validation", "heldout")}
-    if not all(ids.values()):
-        raise InputError(f"room type '{room_type}' has {len(graphs)} graph(s); training needs 3 or more "
-                         "(fitted, validation and held-out)")
-    train_g, val_g, held_g = ([by_id[i] for i in ids[s]] for s in ("fit", "validation", "heldout"))
+    parts = split_graphs(graphs, split, room_type)
+    ids = {s: [g.room_id for g in gs] for s, gs in parts.items()}
+    train_g, val_g, held_g = parts["fit"], parts["validation"], parts["heldout"]
     device = pick_device(gm["device"])
     chash = config_hash({"preset": preset, "max_edges": gm["max_edges"], "heldout_fraction": gm["heldout_fraction"],
                          "validation_fraction": gm["validation_fraction"], "seed": config["seed"],
-                         "room_type": room_type, "graphs": sorted(by_id)})
+                         "room_type": room_type, "graphs": sorted(g.room_id for g in graphs)})
     run_ = train.train(train_g, val_g, vocab, preset, gm["max_edges"], config["seed"], progress_file, chash, device,
                        _ticker(room_type, preset))
     test = heldout_scores(run_.model, held_g, vocab, preset, gm["max_edges"], config["seed"], device)

@@ -8,21 +8,18 @@ import zlib
 from collections import Counter
 from pathlib import Path
 
-import numpy as np
 import torch
 
-from .... import tables
 from ....errors import InputError
 from ....graphs import checks as graph_checks
 from ....graphs import data as graph_data
 from ....graphs.data import ARCH
+from ....graphs.generated import contents_of, graph_rows
 from ....learning import checkpoint
-from ....room.contents import learn_contents
 from ....log import progress
 from . import train
 from .sampler import sample
 from .spec import load_spec
-from .tables import grown_rows
 
 log = logging.getLogger("planit.sample_graphs")
 
@@ -77,18 +74,6 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     return rows_n, rows_e, summary
 
 
-def contents_of(train: list, vocab, cfg: dict) -> tuple[np.ndarray | None, set[int]]:
-    """From the training graphs (``train``): each category's largest count in one room as ``(categories,)`` caps
-    (None when ``cfg['cap_counts']`` is off, or without training graphs) and the node classes of the required
-    categories (:func:`pipeline.room.contents.learn_contents` with ``cfg['required_share']``: none above 1, which no
-    Wilson bound reaches)."""
-    learned = learn_contents([[vocab.node_classes[c] for c in g.node_class[g.n_arch:]] for g in train],
-                             cfg["required_share"])
-    cats = vocab.node_classes[len(ARCH):]
-    caps = np.array([learned["max_count"].get(c, 0) for c in cats]) if cfg["cap_counts"] and train else None
-    return caps, {vocab.node_classes.index(c) for c in learned["required"]}
-
-
 def _plan_triples(plan) -> set[tuple[int, int, int]]:
     cls = [len(ARCH) + c for c, _, _ in plan.objects]
     return {(cls[k], cls[j], c) if d == 0 else (cls[j], cls[k], c) for k, d, c, j in plan.edges}
@@ -118,30 +103,3 @@ def _sample_valid(net, vocab, held, n, sc, rules, plan, base_seed, max_edges, ro
         if not pending:
             break
     return kept, first_try, reasons
-
-
-def graph_rows(kept: dict, vocab, nodes: Path, edges: Path, room_type: str, prefix: str) -> tuple[list[dict], list[dict]]:
-    """The kept graphs as generated_nodes / generated_edges rows, architecture copied from their rooms."""
-    flt = [("room_type", "=", room_type)]
-    arch_rows = _architecture_rows(tables.read(nodes, "final_nodes", filters=flt).to_pandas(),
-                                   tables.read(edges, "final_edges", filters=flt).to_pandas())
-    rows_n, rows_e = [], []
-    for i in sorted(kept):
-        g, seed = kept[i]
-        an, ae = arch_rows[g.arch.room_id]
-        nn_, ee = grown_rows(g, vocab, an, ae, f"{prefix}_{i:05d}", room_type, seed)
-        rows_n += nn_
-        rows_e += ee
-    return rows_n, rows_e
-
-
-def _architecture_rows(node_df, edge_df) -> dict:
-    """Per room: its architecture node rows (in the graph's order) and its kept architecture edges."""
-    out = {}
-    arch_e = edge_df[edge_df["edge_type"].astype(str).isin(["wall_adjacent", "wall_opposite", "opening"])
-                     & (edge_df["status"].astype(str) == "kept")]
-    by_room = dict(tuple(arch_e.groupby("room_id", sort=False)))
-    for room, g in node_df[node_df["kind"].astype(str) != "object"].groupby("room_id", sort=False):
-        out[room] = (g.sort_values("node_id"), by_room.get(room, arch_e.iloc[:0]))
-    return out
-

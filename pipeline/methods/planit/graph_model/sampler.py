@@ -15,6 +15,7 @@ import torch
 import torch.nn.functional as F
 
 from ....graphs import checks as graph_checks
+from ....graphs.generated import Grown
 from ....graphs.data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, features, node_features
 from .model import EDGE_CHOICES, GraphModel
 from .teacher import candidate_logits, edge_features
@@ -26,17 +27,6 @@ class Plan:
     order, and edges ``(object k, direction, type, object j)``, k < j: direction 0 is k -> j."""
     objects: list[tuple[int, int | None, int | None]] = field(default_factory=list)
     edges: list[tuple[int, int, int, int]] = field(default_factory=list)
-
-
-@dataclass
-class Grown:
-    """A sampled graph over node positions: the architecture's nodes first (``arch.n_arch``), then the objects;
-    ``edges`` rows (source, target, class), architecture edges included."""
-    arch: Graph
-    node_class: list[int]
-    symmetry: list[int]
-    role: list[int]
-    edges: list[tuple[int, int, int]]
 
 
 @functools.lru_cache(maxsize=8)

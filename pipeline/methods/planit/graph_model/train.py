@@ -9,7 +9,6 @@ config hash: a checkpoint of other settings is never resumed.
 """
 from __future__ import annotations
 
-import copy
 import logging
 import time
 from dataclasses import dataclass
@@ -18,8 +17,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .... import tables
-from ....learning import checkpoint as ckpt
+from ....learning import epochs
 from ....learning.device import pick_device  # noqa: F401 (re-exported for the stages)
 from ....graphs.data import Graph, Vocab, sequence
 from .model import GraphModel
@@ -77,20 +75,6 @@ def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) ->
     return total / max(len(seqs), 1), dropped
 
 
-def _resume(model, opt, checkpoint: Path, config_hash: str, device: str) -> dict:
-    """The training state to go on from: the progress file's when it is of these settings (weights and optimiser
-    loaded into ``model`` and ``opt``), else a fresh one."""
-    saved = ckpt.resume(checkpoint, PROGRESS, config_hash, device)
-    if saved is None:
-        if checkpoint.exists():
-            log.info("checkpoint %s is for other settings: starting afresh", checkpoint)
-        return {"epoch": 0, "history": [], "best": np.inf, "best_epoch": 0, "best_state": None, "stale": 0}
-    model.load_state_dict(saved.state["model"])
-    opt.load_state_dict(saved.state["optimizer"])
-    log.info("resumed from %s after epoch %d", checkpoint, saved.record["epoch"])
-    return {**saved.record, "best_state": saved.state["best_state"]}
-
-
 def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, preset: dict, max_edges: int, seed: int,
           checkpoint: Path, config_hash: str, device: str = "cpu", progress=None) -> Run:
     """Fit ``train_graphs`` until the ``validation`` NLL has not improved by ``preset['min_improvement']``
@@ -99,7 +83,7 @@ def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, pres
     torch.manual_seed(seed)
     model = build_model(vocab, preset).to(device)
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
-    state = _resume(model, opt, checkpoint, config_hash, device)
+    state = epochs.resume(model, opt, checkpoint, PROGRESS, config_hash, device)
     resumed = state["epoch"]
     while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
         epoch = state["epoch"] + 1
@@ -112,17 +96,8 @@ def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, pres
         row = {"epoch": epoch, "train_nll": train_nll, "validation_nll": val["per_graph"],
                **{f"validation_{k}": val[k] for k in KINDS},
                "seconds": seconds, "graphs_per_s": len(train_graphs) / max(seconds, 1e-9), "edges_dropped": dropped}
-        state["history"].append(row)
-        if row["validation_nll"] < state["best"] * (1 - preset["min_improvement"]):
-            state["stale"] = 0
-        else:
-            state["stale"] += 1
-        if row["validation_nll"] < state["best"]:
-            state.update(best=row["validation_nll"], best_epoch=epoch, best_state=copy.deepcopy(model.state_dict()))
-        state["epoch"] = epoch
-        ckpt.save(checkpoint, ckpt.Checkpoint(PROGRESS, config_hash, {
-            "model": model.state_dict(), "optimizer": opt.state_dict(), "best_state": state["best_state"]},
-            {k: v for k, v in state.items() if k != "best_state"}))
+        gain = row["validation_nll"] < state["best"] * (1 - preset["min_improvement"])
+        epochs.record(state, model, opt, row, row["validation_nll"], gain, checkpoint, PROGRESS, config_hash)
         if progress:
             progress(epoch, row)
     if state["best_state"] is not None:

@@ -1,0 +1,160 @@
+"""Room graphs sampled as strings: each string starts with a held-out room's architecture (forced), the VAE writes
+the objects; a string that does not parse, breaks the training grammar or fails the checks every generated graph
+passes (``graphs/checks.py``, and the plausible contents learned from the training graphs) is rejected, counted by
+reason and sampled again (a budget). Kept graphs become generated_nodes / generated_edges rows like PlanIT's."""
+from __future__ import annotations
+
+import logging
+import zlib
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ...errors import InputError
+from ...graphs import checks as graph_checks
+from ...graphs.data import ARCH, Graph, Vocab
+from ...graphs.generated import Grown, contents_of, graph_rows
+from ...learning import checkpoint
+from ...log import progress
+from . import sample as decoding
+from . import train
+from .grammar import Grammar, learn_grammar
+from .serialize import StringError, arch_prefix, parse, string_graph
+from .vocab import EOS, TokenVocab
+
+log = logging.getLogger("planit.sample_graphs")
+
+
+def load_model(path: Path):
+    """The checkpoint's record, graph vocabulary, token vocabulary and rebuilt VAE (eval mode, CPU)."""
+    ckpt = checkpoint.load(path, train.KIND)
+    rec = ckpt.record
+    tokens = TokenVocab(tuple(rec["tokens"]))
+    model = train.build_model(tokens, rec["preset"])
+    model.load_state_dict(ckpt.state["model"])
+    model.eval()
+    return rec, Vocab(tuple(rec["categories"])), tokens, model
+
+
+class Rules:
+    """What a sampled graph must keep to, learned from the training graphs: the grammar (and the decoder's mask at the
+    edge detail), the seen edge triples, the count caps and required classes, the classes seen near two opposite
+    walls, each category's usual symmetry."""
+
+    def __init__(self, train_graphs: list[Graph], vocab: Vocab, detail: str, contents: dict):
+        strings = [string_graph(g, vocab) for g in train_graphs]
+        self.grammar: Grammar = learn_grammar(strings, detail)
+        self.mask_grammar: Grammar = learn_grammar(strings, "edge")  # the decoder's mask: whole edge classes
+        self.seen = graph_checks.seen_triples(train_graphs)
+        self.caps, self.required = contents_of(train_graphs, vocab, contents)
+        self.opposite_ok = {int(g.node_class[k]) for g in train_graphs for k in graph_checks.near_opposite_walls(
+            g.node_class.tolist(), [tuple(e) for e in g.edges.tolist()])}
+        tally: dict[int, Counter] = {}
+        for g in train_graphs:
+            for c, s in zip(g.node_class[g.n_arch:], g.symmetry[g.n_arch:]):
+                tally.setdefault(int(c), Counter())[int(s)] += 1
+        self.symmetry = {c: t.most_common(1)[0][0] for c, t in tally.items()}
+
+
+def to_grown(text: str, room: Graph, vocab: Vocab, rules: Rules) -> tuple[Grown | None, list[str]]:
+    """The graph of one decoded string in ``room``'s architecture, or None and the reasons it is rejected."""
+    try:
+        sg = parse(text)
+    except StringError:
+        return None, ["unparsable"]
+    n_arch = room.n_arch
+    _, order = arch_prefix(string_graph(room, vocab), n_arch)
+    names = sg.names[n_arch:]
+    if any(n in ARCH or n not in vocab.node_classes for n in names):
+        return None, ["unknown_object"]
+    if not rules.grammar.valid(sg):
+        return None, ["grammar"]
+    node = [*order, *range(n_arch, n_arch + len(names))]  # parsed atom -> node of the grown graph
+    cls = [*room.node_class[:n_arch].tolist(), *(vocab.node_classes.index(n) for n in names)]
+    edges = [(node[s], node[t], int(c)) for s, t, c in sg.edges.tolist()]
+    bad = graph_checks.problems(cls, [0] * len(cls), edges, n_arch, rules.seen, rules.required, rules.opposite_ok)
+    counts = np.bincount(np.array(cls[n_arch:], int) - len(ARCH), minlength=len(vocab.categories))
+    if rules.caps is not None and (counts[:len(rules.caps)] > rules.caps).any():
+        bad.append("excess_contents")
+    if bad:
+        return None, bad
+    sym = [*room.symmetry[:n_arch].tolist(), *(rules.symmetry.get(c, 0) for c in cls[n_arch:])]
+    return Grown(room, cls, sym, [0] * len(cls), edges), []
+
+
+def sample_room_type(config: dict, model: Path, graphs: list[Graph], nodes: Path, edges: Path, room_type: str,
+                     spec: Path | None = None, count: int | None = None, threads: int = 1,
+                     prefix: str | None = None) -> tuple[list, list, dict]:
+    """``count`` (default ``strings.sample.graphs``) valid graphs in held-out rooms' architectures (in turn) as
+    generated_nodes / generated_edges rows, and a summary (valid before rejection, rejections by reason)."""
+    if spec is not None:
+        raise InputError(f"{spec}: the strings graph generator does not complete partial graphs (PlanIT's does)")
+    sc = config["strings"]["sample"]
+    torch.set_num_threads(threads)
+    rec, vocab, tokens, net = load_model(model)
+    by_id = {g.room_id: g for g in graphs}
+    held = [by_id[i] for i in rec["heldout_ids"] if i in by_id]
+    if not held:
+        raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain it")
+    rules = Rules([by_id[i] for i in rec["train_ids"] + rec["validation_ids"] if i in by_id], vocab, sc["grammar"],
+                  config["graph_model"]["sample"]["contents"])
+    n = count or sc["graphs"]
+    seed = zlib.crc32(f"{config['seed']}/{room_type}/strings".encode())
+    kept, first_try, reasons = _sample_valid(net, tokens, vocab, held, n, sc, rules, seed, room_type)
+    rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"strings_{room_type}")
+    summary = {"room_type": room_type, "generator": "strings", "requested": n, "written": len(kept),
+               "failed_after_budget": n - len(kept), "valid_before_rejection": round(first_try / max(n, 1), 4),
+               "rejections": dict(reasons), "temperature": sc["temperature"], "spec": None}
+    log.info("%s", summary)
+    return rows_n, rows_e, summary
+
+
+def prefixes(rooms: list[Graph], vocab: Vocab, tokens: TokenVocab) -> list[list[int]]:
+    """Each room's forced prefix as token indices: its architecture's string and ``.``."""
+    return [tokens.encode([arch_prefix(string_graph(g, vocab), g.n_arch)[0] + "."])[0, 1:-1].tolist() for g in rooms]
+
+
+def masker(tokens: TokenVocab, vocab: Vocab, n: int, rules: Rules, mask: str) -> decoding.Syntax | None:
+    """The decoder's mask for ``n`` strings (``strings.sample.mask``: none, syntax, grammar)."""
+    if mask == "none":
+        return None
+    if mask == "syntax":
+        return decoding.Syntax(tokens, n, arch_tokens(tokens))
+    caps = {} if rules.caps is None else {c: int(k) for c, k in zip(vocab.categories, rules.caps)}
+    return decoding.Syntax(tokens, n, arch_tokens(tokens), rules.mask_grammar, caps)
+
+
+def arch_tokens(tokens: TokenVocab) -> set[int]:
+    """The architecture's atoms: a room's string holds them in its forced prefix only."""
+    return {k for k, t in enumerate(tokens.tokens) if t.startswith("[") and t[1:-1] in ARCH}
+
+
+def _sample_valid(net, tokens, vocab, held, n, sc, rules, seed, room_type) -> tuple[dict, int, Counter]:
+    """Graph index -> (valid Grown, seed); how many were valid at the first try; rejections by reason (``unfinished``:
+    no end token within ``max_length``; ``dead_end``: the mask left no token to draw)."""
+    kept, first_try, reasons, eos = {}, 0, Counter(), tokens.index[EOS]
+    pending = list(range(n))
+    for attempt in range(sc["resample_budget"] + 1):
+        for k in progress(range(0, len(pending), sc["batch_size"]), desc=f"strings {room_type}, try {attempt + 1}"):
+            part = pending[k:k + sc["batch_size"]]
+            s = seed + 1_000_003 * attempt + k
+            gen = torch.Generator().manual_seed(s)
+            rooms = [held[i % len(held)] for i in part]
+            z = decoding.prior_codes(len(part), net.to_mu.out_features, gen)
+            syntax = masker(tokens, vocab, len(part), rules, sc["mask"])
+            rows = decoding.decode(net, z, prefixes(rooms, vocab, tokens), tokens, sc["max_length"], sc["temperature"],
+                                   gen, syntax)
+            dead = syntax.dead if syntax is not None else set()
+            for r, (i, room, row) in enumerate(zip(part, rooms, rows)):
+                grown, bad = ((None, ["dead_end"]) if r in dead else (None, ["unfinished"]) if eos not in row
+                              else to_grown(tokens.decode(row), room, vocab, rules))
+                reasons.update(bad)
+                first_try += attempt == 0 and not bad
+                if grown is not None:
+                    kept[i] = (grown, s)
+        pending = [i for i in pending if i not in kept]
+        if not pending:
+            break
+    return kept, first_try, reasons
