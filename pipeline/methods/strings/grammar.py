@@ -80,17 +80,6 @@ class Grammar:
         return (">" if out else "<", relation(edge_class, self.detail), neighbour)
 
 
-def node_bonds(names, edges, node: int, grammar: Grammar) -> Counter:
-    """The bonds ``node`` holds among ``edges`` (source, target, class) at the grammar's detail."""
-    out = Counter()
-    for s, t, c in edges:
-        if s == node:
-            out[grammar.bond(True, c, names[t])] += 1
-        if t == node:
-            out[grammar.bond(False, c, names[s])] += 1
-    return out
-
-
 def learn_grammar(graphs: list[StringGraph], detail: str = "edge") -> Grammar:
     """The grammar of a training split's graphs at ``detail`` (:data:`DETAILS`)."""
     if detail not in DETAILS:

@@ -39,14 +39,11 @@ def load_model(path: Path):
 
 
 class Rules:
-    """What a sampled graph must keep to, learned from the training graphs: the grammar (and the decoder's mask at the
-    edge detail), the seen edge triples, the count caps and required classes, the classes seen near two opposite
-    walls, each category's usual symmetry."""
+    """What a sampled graph must keep to, learned from the training graphs: the grammar, the seen edge triples, the
+    count caps and required classes, the classes seen near two opposite walls, each category's usual symmetry."""
 
     def __init__(self, train_graphs: list[Graph], vocab: Vocab, detail: str, contents: dict):
-        strings = [string_graph(g, vocab) for g in train_graphs]
-        self.grammar: Grammar = learn_grammar(strings, detail)
-        self.mask_grammar: Grammar = learn_grammar(strings, "edge")  # the decoder's mask: whole edge classes
+        self.grammar: Grammar = learn_grammar([string_graph(g, vocab) for g in train_graphs], detail)
         self.seen = graph_checks.seen_triples(train_graphs)
         self.caps, self.required = contents_of(train_graphs, vocab, contents)
         self.opposite_ok = {int(g.node_class[k]) for g in train_graphs for k in graph_checks.near_opposite_walls(
@@ -123,7 +120,9 @@ def masker(tokens: TokenVocab, vocab: Vocab, n: int, rules: Rules, mask: str) ->
     if mask == "syntax":
         return decoding.Syntax(tokens, n, arch_tokens(tokens))
     caps = {} if rules.caps is None else {c: int(k) for c, k in zip(vocab.categories, rules.caps)}
-    return decoding.Syntax(tokens, n, arch_tokens(tokens), rules.mask_grammar, caps)
+    names = vocab.node_classes
+    seen = {(names[a], names[b], c) for a, b, c in rules.seen}
+    return decoding.Syntax(tokens, n, arch_tokens(tokens), rules.grammar, caps, seen, {names[c] for c in rules.required})
 
 
 def arch_tokens(tokens: TokenVocab) -> set[int]:

@@ -9,10 +9,10 @@ from collections import Counter
 import numpy as np
 import torch
 
-from ...graphs.data import EDGE_CLASSES
+from ...graphs.data import EDGE_CLASSES, N_OBJECT_EDGES
 
 from .model import SeqVAE
-from .grammar import Grammar, node_bonds
+from .grammar import Grammar
 from .serialize import Reader, label_fault
 from .vocab import BOS, EOS, PAD, SPECIAL, TokenVocab
 
@@ -44,67 +44,116 @@ def encode_means(model: SeqVAE, strings: list[str], vocab: TokenVocab, max_lengt
 
 class Syntax:
     """Per string a parser over its tokens so far: the tokens it may take next (``banned`` token indices never).
-    With a ``grammar`` (and ``caps``: category -> most per room), a token that would give a node a bond the training
-    graphs never hold, more of one than they hold, or a category more often than any training room is masked too
+    With a ``grammar`` (``caps``: category -> most per room; ``seen``: (source class, target class, edge class)
+    triples; ``required``: categories every room holds), a token that would give a node a bond the training graphs
+    never hold, more of one than they hold, an edge of a kind never seen between its two classes, or a category more
+    often than any training room is masked too, and the string may end only once it holds the required categories
     (as PlanIT's sampler masks unseen edges and counts)."""
 
     def __init__(self, vocab: TokenVocab, n: int, banned: set[int] = frozenset(), grammar: Grammar | None = None,
-                 caps: dict[str, int] | None = None):
+                 caps: dict[str, int] | None = None, seen: set[tuple[str, str, int]] | None = None,
+                 required: set[str] = frozenset()):
         self.tokens, self.ix = vocab.tokens, vocab.index
         self.readers = [Reader() for _ in range(n)]
         self.open = [k for k, t in enumerate(vocab.tokens) if t not in SPECIAL and k not in banned]
-        self.grammar, self.caps = grammar, caps or {}
+        self.given = {vocab.tokens[k][1:-1] for k in banned}  # classes of the forced prefix only: referred to
+        self.grammar, self.caps, self.seen, self.required = grammar, caps or {}, seen, set(required)
         self.dead: set[int] = set()  # rows where no token fitted
+        self.base = [None] * n  # atoms of the forced prefix (the architecture), at the first "."
+        self.start = [0] * n  # the first atom of the component being written
         self.labels = {t: [(lab[0] == ">", EDGE_CLASSES.index(lab[1:])) for lab in filter(None, t[1:-1].split("|"))]
                        for t in vocab.tokens if t.startswith("{") and label_fault(t) is None}
 
     def take(self, row: int, token: int) -> None:
-        tok = self.tokens[token]
+        tok, reader = self.tokens[token], self.readers[row]
         if tok not in SPECIAL:
-            self.readers[row].read(tok, len(self.readers[row].names))
+            reader.read(tok, len(reader.names))
+        if tok == ".":
+            self.base[row] = len(reader.names) if self.base[row] is None else self.base[row]
+            self.start[row] = len(reader.names)
+
+    def _anchored(self, row: int) -> bool:
+        """The component being written has an edge to the architecture (else it would stand apart)."""
+        base, start = self.base[row], self.start[row]
+        return base is None or any(min(s, t) < base <= start <= max(s, t) for s, t, _ in self.readers[row].edges)
 
     def mask(self, rows: list[int]) -> torch.Tensor:
         """``(len(rows), vocab)`` bool: allowed next tokens of each row."""
         out = torch.zeros(len(rows), len(self.tokens), dtype=torch.bool)
         for r, row in enumerate(rows):
             reader = self.readers[row]
-            held = self._held(reader, reader.current) if reader.current is not None and self.grammar else None
-            out[r, [k for k in self.open if reader.fault(self.tokens[k]) is None and self._fits(reader, k, held)]] = True
-            out[r, self.ix[EOS]] = reader.end_fault() is None
+            held = self._held(reader) if reader.current is not None and self.grammar else None
+            allowed = [k for k in self.open if reader.fault(self.tokens[k]) is None and self._fits(reader, k, held)]
+            if held is not None and not any(self.tokens[k].startswith("{") for k in allowed):
+                allowed = [k for k in allowed if not self._opens(reader, self.tokens[k])]  # nothing could go on there
+            closes = held is None or self._anchored(row)
+            out[r, [k for k in allowed if closes or self.tokens[k] != "."]] = True
+            out[r, self.ix[EOS]] = reader.end_fault() is None and (held is None or (
+                closes and self.required <= set(reader.names)))
             if not out[r].any():  # nothing fits: the string ends here, unfinished (counted as a dead end)
                 out[r, self.ix[EOS]] = True
                 self.dead.add(row)
         return out
 
-    def _held(self, reader: Reader, node: int) -> Counter:
-        return node_bonds(reader.names, reader.edges, node, self.grammar)
+    @staticmethod
+    def _opens(reader: Reader, tok: str) -> bool:
+        """A branch or a new ring: tokens that need a bond later."""
+        return tok == "(" or (tok.startswith("%") and int(tok[1:]) not in reader.rings)
 
-    def _fits(self, reader: Reader, k: int, held: Counter | None) -> bool:
+    def _held(self, reader: Reader) -> list[Counter]:
+        """Every node's bonds so far, at the grammar's detail."""
+        out = [Counter() for _ in reader.names]
+        for s, t, c in reader.edges:
+            out[s][self.grammar.bond(True, c, reader.names[t])] += 1
+            out[t][self.grammar.bond(False, c, reader.names[s])] += 1
+        return out
+
+    def _under_cap(self, reader: Reader, name: str) -> bool:
+        return reader.names.count(name) < self.caps.get(name, len(reader.names) + 1)
+
+    def _takers(self, reader: Reader, held: list[Counter], bond: str) -> bool:
+        """Whether some atom can take ``bond`` from the current atom: a new one of a class seen beside it, an earlier
+        one of a given class (a reference) or one with an open ring (closing it)."""
+        if any(o != reader.current and self._bond_fits(reader, held, reader.names[o], o, bond)
+               for o, _ in reader.rings.values()):
+            return True
+        for name in self.grammar.neighbours(reader.names[reader.current]):
+            if name in self.given:
+                if any(self._bond_fits(reader, held, name, k, bond) for k, n in enumerate(reader.names[:reader.current])
+                       if n == name):
+                    return True
+            elif self._under_cap(reader, name) and self._bond_fits(reader, held, name, None, bond):
+                return True
+        return False
+
+    def _fits(self, reader: Reader, k: int, held: list[Counter] | None) -> bool:
         """Whether token ``k`` keeps the string within the caps and the grammar (syntax aside)."""
         tok = self.tokens[k]
         if tok.startswith("["):
             name = tok[1:-1]
-            if reader.names.count(name) >= self.caps.get(name, len(reader.names) + 1):
+            if not self._under_cap(reader, name):
                 return False
             return held is None or reader.bond is None or self._bond_fits(reader, held, name, None)
-        if held is not None and tok.startswith("{"):  # a bond some new atom can take (a look ahead, no dead end)
-            return any(self._bond_fits(reader, held, name, None, tok) for name in self.grammar.neighbours(
-                reader.names[reader.current]) if reader.names.count(name) < self.caps.get(name, len(reader.names) + 1))
+        if held is not None and tok.startswith("{"):  # a bond some atom can take (a look ahead: fewer dead ends)
+            return self._takers(reader, held, tok)
         if held is None or reader.bond is None or tok[0] not in "%@" or (tok[0] == "%" and int(tok[1:]) not in reader.rings):
             return True
         target = reader.rings[int(tok[1:])][0] if tok[0] == "%" else int(tok[1:])
         return self._bond_fits(reader, held, reader.names[target], target)
 
-    def _bond_fits(self, reader: Reader, held: Counter, name: str, target: int | None, bond: str | None = None) -> bool:
+    def _bond_fits(self, reader: Reader, held: list[Counter], name: str, target: int | None,
+                   bond: str | None = None) -> bool:
         """The pending bond (or ``bond``) between the current atom and ``target`` (None: a new atom of class ``name``,
         written after it; else an earlier atom) within both nodes' grammar."""
         mine, theirs, here = [], [], reader.names[reader.current]
         for fwd, c in self.labels.get(bond or reader.bond, []):
             out = fwd if target is None else not fwd  # fwd: from the earlier atom to the later
+            if self.seen is not None and c < N_OBJECT_EDGES and ((here, name, c) if out else (name, here, c)) not in self.seen:
+                return False
             mine.append(self.grammar.bond(out, c, name))
             theirs.append(self.grammar.bond(not out, c, here))
-        other = Counter() if target is None else self._held(reader, target)
-        return self.grammar.fits(here, held, mine) and self.grammar.fits(name, other, theirs)
+        other = Counter() if target is None else held[target]
+        return self.grammar.fits(here, held[reader.current], mine) and self.grammar.fits(name, other, theirs)
 
 
 def decode(model: SeqVAE, z: torch.Tensor, prefixes: list[list[int]], vocab: TokenVocab, max_length: int,

@@ -215,10 +215,13 @@ class Reader:
         self.bond: str | None = None
         self.branches: list[int] = []
         self.rings: dict[int, tuple[int, int]] = {}  # digit -> (opening atom, token index)
+        self.branch_opened = False  # the last token was "(": a bond must come next
 
     def fault(self, tok: str) -> str | None:
         """Why ``tok`` may not come next (None: it may)."""
         atom, bonded = self.current is not None, self.bond is not None
+        if self.branch_opened and not tok.startswith("{"):
+            return "a branch starts with a bond"
         if tok.startswith("["):
             return "an atom after an atom needs a bond between them" if atom and not bonded else None
         if tok.startswith("{"):
@@ -240,6 +243,10 @@ class Reader:
             return "a branch must follow an atom" if not atom or bonded else None
         if tok == ")":
             return "no open branch" if not self.branches else "a bond with no atom after it" if bonded else None
+        if not atom:
+            return "'.' must follow an atom"
+        if self.rings:
+            return f"'.' with ring {next(iter(self.rings))} open (a ring closes within its component)"
         return "'.' inside a branch or after a bond" if bonded or self.branches else None
 
     def read(self, tok: str, i: int) -> None:
@@ -247,6 +254,7 @@ class Reader:
         fault = self.fault(tok)
         if fault is not None:
             raise StringError(f"token {i} '{tok}': {fault}")
+        self.branch_opened = tok == "("
         if tok.startswith("["):
             self.names.append(tok[1:-1])
             if self.bond is not None:
