@@ -1,7 +1,7 @@
 """The string VAE (issue 31, item 3) on a pipeline run's trained models: per room type, milliseconds per sampled
-graph in batches, the share valid before rejection with and without the syntax mask, the rejections by reason,
+graph in batches, the share valid before rejection under each decoder mask (grammar, syntax, none), the rejections,
 interpolation (32 codes on a straight path between two held-out rooms' codes, decoded greedily in the first room's
-architecture: the share of points giving a valid graph) and, from the run's metrics.json files, each graph metric
+architecture under the config's mask: the share of points giving a valid graph) and, from the run's metrics.json files, each graph metric
 of the string VAE beside PlanIT's graph model's (the goal: within 1.2x on every room type).
 
     .venv/bin/python bench/strings_vae.py [--room-types bedroom ...] [--graphs 200] [--pairs 5]
@@ -31,18 +31,20 @@ RUN = ROOT / "results"
 METRICS = ("node_count_tv", "category_kl", "edge_type_kl", "degree_mmd")
 
 
-def draw(net, tokens, vocab, held, rules, n, cfg, syntax: bool, seed: int) -> tuple[int, Counter, float]:
-    """Valid graphs of ``n`` drawn at once, the rejections, seconds."""
+def draw(net, tokens, vocab, held, rules, n, cfg, mask: str, seed: int) -> tuple[int, Counter, float]:
+    """Valid graphs of ``n`` drawn at once with the decoder's ``mask``, the rejections, seconds."""
     gen = torch.Generator().manual_seed(seed)
     rooms = [held[i % len(held)] for i in range(n)]
     start = time.perf_counter()
     z = decoding.prior_codes(n, net.to_mu.out_features, gen)
-    mask = decoding.Syntax(tokens, n, R.arch_tokens(tokens)) if syntax else None
-    rows = decoding.decode(net, z, R.prefixes(rooms, vocab, tokens), tokens, cfg["max_length"], cfg["temperature"], gen, mask)
+    masker = R.masker(tokens, vocab, n, rules, mask)
+    rows = decoding.decode(net, z, R.prefixes(rooms, vocab, tokens), tokens, cfg["max_length"], cfg["temperature"], gen,
+                           masker)
     seconds = time.perf_counter() - start
-    reasons, ok = Counter(), 0
-    for room, row in zip(rooms, rows):
-        grown, bad = R.to_grown(tokens.decode(row), room, vocab, rules) if tokens.index["<eos>"] in row else (None, ["unfinished"])
+    reasons, ok, dead = Counter(), 0, masker.dead if masker is not None else set()
+    for k, (room, row) in enumerate(zip(rooms, rows)):
+        grown, bad = ((None, ["dead_end"]) if k in dead else (None, ["unfinished"]) if tokens.index["<eos>"] not in row
+                      else R.to_grown(tokens.decode(row), room, vocab, rules))
         ok += grown is not None
         reasons.update(bad)
     return ok, reasons, seconds
@@ -57,9 +59,11 @@ def interpolation(net, tokens, vocab, held, rules, cfg, pairs: int) -> float:
     for _ in range(pairs):
         a, b = rng.choice(len(held), 2, replace=False)
         z = decoding.path_codes(mu[a], mu[b], 32)
+        masker = R.masker(tokens, vocab, 32, rules, cfg["mask"])
         rows = decoding.decode(net, z, R.prefixes([held[a]] * 32, vocab, tokens), tokens, cfg["max_length"], 0.0,
-                               torch.Generator().manual_seed(0), decoding.Syntax(tokens, 32, R.arch_tokens(tokens)))
-        valid += [R.to_grown(tokens.decode(r), held[a], vocab, rules)[0] is not None for r in rows]
+                               torch.Generator().manual_seed(0), masker)
+        valid += [k not in masker.dead and R.to_grown(tokens.decode(r), held[a], vocab, rules)[0] is not None
+                  for k, r in enumerate(rows)]
     return round(float(np.mean(valid)), 3)
 
 
@@ -74,10 +78,10 @@ def room_type_figures(room_type: str, graphs: int, pairs: int, config: dict) -> 
     rules = R.Rules([by_id[i] for i in rec["train_ids"] + rec["validation_ids"]], vocab, cfg["grammar"],
                     config["graph_model"]["sample"]["contents"])
     out = {}
-    for syntax in (True, False):
-        ok, reasons, seconds = draw(net, tokens, vocab, held, rules, graphs, cfg, syntax, 1)
-        out["syntax" if syntax else "raw"] = {"valid": round(ok / graphs, 3), "ms_per_graph": round(1000 * seconds / graphs, 2),
-                                               "rejections": dict(reasons.most_common())}
+    for mask in ("grammar", "syntax", "none"):
+        ok, reasons, seconds = draw(net, tokens, vocab, held, rules, graphs, cfg, mask, 1)
+        out[f"mask_{mask}"] = {"valid": round(ok / graphs, 3), "ms_per_graph": round(1000 * seconds / graphs, 2),
+                               "rejections": dict(reasons.most_common())}
     out["interpolation_valid"] = interpolation(net, tokens, vocab, held, rules, cfg, pairs)
     ratios = {}
     for gen in ("planit", "strings"):

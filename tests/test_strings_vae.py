@@ -4,7 +4,6 @@ test_e2e.py."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 import torch
 
 from pipeline.methods.strings import sample as decoding
