@@ -123,7 +123,7 @@ def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, a fol
     """Print a table's schema, row count and per-column summary; for graphs, the per-room-type report. Reads only."""
     if not path.exists():
         _fail(f"{path}: no such table, folder or metrics file")
-    if path.is_dir() and (path / "metrics.json").exists() or path.suffix == ".json" or path.name == "graph_model":
+    if path.is_dir() and ((path / "metrics.json").exists() or "graph_model" in path.parts) or path.suffix == ".json":
         from .stats import print_metrics
 
         _guard(print_metrics, path, sys.stdout)

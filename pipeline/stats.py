@@ -45,19 +45,20 @@ def _flat(value, prefix: str = "") -> list[tuple[str, object]]:
 
 
 def print_metrics(path: str | Path, stream: TextIO) -> None:
-    """Graph-model metrics side by side: one column per room type (``path``: a metrics JSON, a room type's folder,
-    or the graph_model folder holding one folder per room type)."""
+    """Graph-generator metrics side by side: one column per room type and generator (``path``: a metrics JSON, a
+    generator's folder, a room type's folder or the graph_model folder, ``results/graph_model/<type>/<generator>/``)."""
     import json
 
     path = Path(path)
     files = ([path] if path.suffix == ".json" else [path / "metrics.json"] if (path / "metrics.json").exists()
-             else sorted(path.glob("*/metrics.json")))
+             else sorted(path.glob("*/metrics.json")) or sorted(path.glob("*/*/metrics.json")))
     if not files:
         raise tables.TableError(f"{path}: no metrics.json (written by rule graph_model_metrics)")
     columns = {}
     for f in files:
+        name = f"{f.parent.parent.name}/{f.parent.name}" if f.name == "metrics.json" else f.stem
         try:
-            columns[f.parent.name if f.name == "metrics.json" else f.stem] = dict(_flat(json.loads(f.read_text())))
+            columns[name] = dict(_flat(json.loads(f.read_text())))
         except (OSError, ValueError) as exc:
             raise tables.TableError(f"{f}: unreadable metrics ({exc})") from exc
     table = Table(title=f"graph model metrics ({path})")

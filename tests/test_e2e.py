@@ -230,7 +230,7 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
         assert (res / "placement" / room_type / "cfcn" / "loss.png").stat().st_size > 1000
         folder = res / "generated" / room_type / "planit"
         scenes = pd.read_parquet(folder / "scenes.parquet")
-        sampled = pd.read_parquet(res / "graph_model" / room_type / "sampled" / "nodes.parquet").scene_id.nunique()
+        sampled = pd.read_parquet(res / "graph_model" / room_type / "planit" / "sampled" / "nodes.parquet").scene_id.nunique()
         assert len(scenes) == min(2, sampled)  # failed scenes are recorded, never dropped
         assert set(scenes.status) <= {"placed", "failed"} and (scenes[scenes.status == "failed"].reason != "").all()
         entries = tables.read_archive(folder / "scenes.zip")  # one file, no folder: a GLB, PNG and JSON per scene
