@@ -43,7 +43,7 @@ def _room_reasons(room, segs: np.ndarray, objs: dict, cfg: dict, rare: set) -> l
     if big > cfg["max_extent"] or small < cfg["min_extent"]:
         out.append(("room_size", f"extents {room.extent_x:.2f} x {room.extent_y:.2f} m outside "
                                  f"[{cfg['min_extent']}, {cfg['max_extent']}] m"))
-    b, ids = objs["boxes"], objs["ids"]
+    b = objs["boxes"]
     floor = int((b[:, 2] - b[:, 5] <= cfg["floor_contact"]).sum())
     if floor < cfg["min_floor_objects"][rtype]:
         out.append(("too_few_objects", f"{floor} floor objects < {cfg['min_floor_objects'][rtype]}"))
