@@ -37,17 +37,12 @@ def draw(net, tokens, vocab, held, rules, n, cfg, mask: str, seed: int) -> tuple
     rooms = [held[i % len(held)] for i in range(n)]
     start = time.perf_counter()
     z = decoding.prior_codes(n, net.to_mu.out_features, gen)
-    masker = R.masker(tokens, vocab, n, rules, mask)
+    masker = R.masker(tokens, n, rules, mask)
     rows = decoding.decode(net, z, R.prefixes(rooms, vocab, tokens), tokens, cfg["max_length"], cfg["temperature"], gen,
                            masker)
     seconds = time.perf_counter() - start
-    reasons, ok, dead = Counter(), 0, masker.dead if masker is not None else set()
-    for k, (room, row) in enumerate(zip(rooms, rows)):
-        grown, bad = ((None, ["dead_end"]) if k in dead else (None, ["unfinished"]) if tokens.index["<eos>"] not in row
-                      else R.to_grown(tokens.decode(row), room, vocab, rules))
-        ok += grown is not None
-        reasons.update(bad)
-    return ok, reasons, seconds
+    judged = R.verdicts(rows, rooms, tokens, vocab, rules, masker)
+    return sum(g is not None for g, _ in judged), Counter(b for _, bad in judged for b in bad), seconds
 
 
 def interpolation(net, tokens, vocab, held, rules, cfg, pairs: int) -> float:
@@ -59,11 +54,10 @@ def interpolation(net, tokens, vocab, held, rules, cfg, pairs: int) -> float:
     for _ in range(pairs):
         a, b = rng.choice(len(held), 2, replace=False)
         z = decoding.path_codes(mu[a], mu[b], 32)
-        masker = R.masker(tokens, vocab, 32, rules, cfg["mask"])
+        masker = R.masker(tokens, 32, rules, cfg["mask"])
         rows = decoding.decode(net, z, R.prefixes([held[a]] * 32, vocab, tokens), tokens, cfg["max_length"], 0.0,
                                torch.Generator().manual_seed(0), masker)
-        valid += [k not in masker.dead and R.to_grown(tokens.decode(r), held[a], vocab, rules)[0] is not None
-                  for k, r in enumerate(rows)]
+        valid += [g is not None for g, _ in R.verdicts(rows, [held[a]] * 32, tokens, vocab, rules, masker)]
     return round(float(np.mean(valid)), 3)
 
 

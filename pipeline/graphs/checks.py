@@ -74,6 +74,12 @@ def near_opposite_walls(node_class: list[int], edges: list[tuple[int, int, int]]
                   if any((a, b) in opposite for a in ws for b in ws if a != b))
 
 
+def opposite_classes(graphs) -> set[int]:
+    """The node classes the ``graphs`` show near two opposite walls (a generated graph may place only these so)."""
+    return {int(g.node_class[k]) for g in graphs
+            for k in near_opposite_walls(g.node_class.tolist(), [tuple(e) for e in g.edges.tolist()])}
+
+
 def _chains_consistent(node_class, role, edges, n_arch) -> bool:
     members = {k for k in range(n_arch, len(node_class)) if role[k] in CHAIN_ROLES}
     linked = set()

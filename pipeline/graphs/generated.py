@@ -9,13 +9,16 @@ geometry yet: instantiation places them). Pure NumPy and pandas.
 """
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 import pandas as pd
 
 from .. import tables
+from ..log import progress
 from ..geometry.symmetry import TYPES as SYMMETRIES
 from ..room.contents import learn_contents
 from .data import ARCH, EDGE_CLASSES, N_OBJECT_EDGES, ROLES, Graph, Vocab
@@ -57,7 +60,6 @@ def _tiers(n_arch: int, n: int, parent: dict[int, int]) -> list[int]:
     return tier
 
 
-
 def grown_rows(g: Grown, vocab: Vocab, arch_nodes: pd.DataFrame, arch_edges: pd.DataFrame, scene_id: str,
                room_type: str, seed: int) -> tuple[list[dict], list[dict]]:
     """Node and edge rows of one sampled graph. ``arch_nodes`` / ``arch_edges``: the source room's architecture
@@ -95,6 +97,28 @@ def contents_of(train: list, vocab, cfg: dict) -> tuple[np.ndarray | None, set[i
     return caps, {vocab.node_classes.index(c) for c in learned["required"]}
 
 
+def resample(n: int, budget: int, batch_size: int, base_seed: int, draw: Callable, desc: str) -> tuple[dict, int, Counter]:
+    """``n`` graphs drawn in batches, each rejected one drawn again up to ``budget`` times: graph index -> (valid
+    graph, seed), how many were valid at the first try, rejections by reason. ``draw(part, seed)`` gives a graph and
+    its rejection reasons (none: valid) for each graph index of ``part``; a batch's seed follows from ``base_seed``,
+    the try and the batch alone."""
+    kept, first_try, reasons = {}, 0, Counter()
+    pending = list(range(n))
+    for attempt in range(budget + 1):
+        for k in progress(range(0, len(pending), batch_size), desc=f"{desc}, try {attempt + 1}"):
+            part = pending[k:k + batch_size]
+            seed = base_seed + 1_000_003 * attempt + k
+            for i, (g, bad) in zip(part, draw(part, seed)):
+                reasons.update(bad)
+                first_try += attempt == 0 and not bad
+                if not bad:
+                    kept[i] = (g, seed)
+        pending = [i for i in pending if i not in kept]
+        if not pending:
+            break
+    return kept, first_try, reasons
+
+
 def graph_rows(kept: dict, vocab, nodes: Path, edges: Path, room_type: str, prefix: str) -> tuple[list[dict], list[dict]]:
     """The kept graphs as generated_nodes / generated_edges rows, architecture copied from their rooms."""
     flt = [("room_type", "=", room_type)]
@@ -119,4 +143,3 @@ def _architecture_rows(node_df, edge_df) -> dict:
     for room, g in node_df[node_df["kind"].astype(str) != "object"].groupby("room_id", sort=False):
         out[room] = (g.sort_values("node_id"), by_room.get(room, arch_e.iloc[:0]))
     return out
-

@@ -2,7 +2,6 @@
 node's extras; walls and floor included) and a top-down PNG with the planned graph drawn over it."""
 from __future__ import annotations
 
-
 import numpy as np
 
 from ..room import RoomInput, Walls, wall_footprints

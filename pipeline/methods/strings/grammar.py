@@ -27,12 +27,17 @@ def relation(edge_class: int, detail: str) -> str:
     return ""
 
 
-def bonds_of(graph: StringGraph, detail: str = "edge") -> list[Counter]:
-    """Per node, its bonds at ``detail`` counted."""
-    out = [Counter() for _ in graph.names]
-    for s, t, c in graph.edges.tolist():
-        out[s][(">", relation(c, detail), graph.names[t])] += 1
-        out[t][("<", relation(c, detail), graph.names[s])] += 1
+def bond(out: bool, edge_class: int, neighbour: str, detail: str) -> Bond:
+    """A bond at ``detail``: ``out`` of the node (or into it), its edge class, the neighbour's class."""
+    return (">" if out else "<", relation(edge_class, detail), neighbour)
+
+
+def bonds_of(names, edges, detail: str = "edge") -> list[Counter]:
+    """Per node of ``names``, its bonds among ``edges`` (source, target, edge class) at ``detail`` counted."""
+    out = [Counter() for _ in names]
+    for s, t, c in edges:
+        out[s][bond(True, c, names[t], detail)] += 1
+        out[t][bond(False, c, names[s], detail)] += 1
     return out
 
 
@@ -46,7 +51,7 @@ class Grammar:
     def violations(self, graph: StringGraph) -> list[str]:
         """What a graph does that no training graph did: an unseen class, an unseen bond, more of a bond than seen."""
         out = []
-        for k, (name, counts) in enumerate(zip(graph.names, bonds_of(graph, self.detail))):
+        for k, (name, counts) in enumerate(zip(graph.names, bonds_of(graph.names, graph.edges.tolist(), self.detail))):
             seen = self.most.get(name)
             if seen is None:
                 out.append(f"node {k}: class '{name}' is in no training graph")
@@ -76,8 +81,8 @@ class Grammar:
         return all(seen.get(b, 0) >= held[b] + k for b, k in more.items())
 
     def bond(self, out: bool, edge_class: int, neighbour: str) -> Bond:
-        """A bond at this grammar's detail: ``out`` of the node (or into it), its edge class, the neighbour's class."""
-        return (">" if out else "<", relation(edge_class, self.detail), neighbour)
+        """:func:`bond` at this grammar's detail."""
+        return bond(out, edge_class, neighbour, self.detail)
 
 
 def learn_grammar(graphs: list[StringGraph], detail: str = "edge") -> Grammar:
@@ -86,7 +91,7 @@ def learn_grammar(graphs: list[StringGraph], detail: str = "edge") -> Grammar:
         raise ValueError(f"grammar detail '{detail}' is not one of {DETAILS}")
     most: dict[str, dict[Bond, int]] = {}
     for g in graphs:
-        for name, counts in zip(g.names, bonds_of(g, detail)):
+        for name, counts in zip(g.names, bonds_of(g.names, g.edges.tolist(), detail)):
             acc = most.setdefault(name, {})
             for bond, n in counts.items():
                 acc[bond] = max(acc.get(bond, 0), n)

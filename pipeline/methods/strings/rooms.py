@@ -15,9 +15,8 @@ import torch
 from ...errors import InputError
 from ...graphs import checks as graph_checks
 from ...graphs.data import ARCH, Graph, Vocab
-from ...graphs.generated import Grown, contents_of, graph_rows
+from ...graphs.generated import Grown, contents_of, graph_rows, resample
 from ...learning import checkpoint
-from ...log import progress
 from . import sample as decoding
 from . import train
 from .grammar import Grammar, learn_grammar
@@ -40,14 +39,18 @@ def load_model(path: Path):
 
 class Rules:
     """What a sampled graph must keep to, learned from the training graphs: the grammar, the seen edge triples, the
-    count caps and required classes, the classes seen near two opposite walls, each category's usual symmetry."""
+    count caps and required classes, the classes seen near two opposite walls, each category's usual symmetry; and
+    the seen triples, caps and required categories by name, as the decoder's mask reads them."""
 
     def __init__(self, train_graphs: list[Graph], vocab: Vocab, detail: str, contents: dict):
         self.grammar: Grammar = learn_grammar([string_graph(g, vocab) for g in train_graphs], detail)
         self.seen = graph_checks.seen_triples(train_graphs)
         self.caps, self.required = contents_of(train_graphs, vocab, contents)
-        self.opposite_ok = {int(g.node_class[k]) for g in train_graphs for k in graph_checks.near_opposite_walls(
-            g.node_class.tolist(), [tuple(e) for e in g.edges.tolist()])}
+        self.opposite_ok = graph_checks.opposite_classes(train_graphs)
+        names = vocab.node_classes
+        self.seen_names = {(names[a], names[b], c) for a, b, c in self.seen}
+        self.caps_by_name = {} if self.caps is None else {c: int(k) for c, k in zip(vocab.categories, self.caps)}
+        self.required_names = {names[c] for c in self.required}
         tally: dict[int, Counter] = {}
         for g in train_graphs:
             for c, s in zip(g.node_class[g.n_arch:], g.symmetry[g.n_arch:]):
@@ -113,16 +116,14 @@ def prefixes(rooms: list[Graph], vocab: Vocab, tokens: TokenVocab) -> list[list[
     return [tokens.encode([arch_prefix(string_graph(g, vocab), g.n_arch)[0] + "."])[0, 1:-1].tolist() for g in rooms]
 
 
-def masker(tokens: TokenVocab, vocab: Vocab, n: int, rules: Rules, mask: str) -> decoding.Syntax | None:
+def masker(tokens: TokenVocab, n: int, rules: Rules, mask: str) -> decoding.Syntax | None:
     """The decoder's mask for ``n`` strings (``strings.sample.mask``: none, syntax, grammar)."""
     if mask == "none":
         return None
     if mask == "syntax":
         return decoding.Syntax(tokens, n, arch_tokens(tokens))
-    caps = {} if rules.caps is None else {c: int(k) for c, k in zip(vocab.categories, rules.caps)}
-    names = vocab.node_classes
-    seen = {(names[a], names[b], c) for a, b, c in rules.seen}
-    return decoding.Syntax(tokens, n, arch_tokens(tokens), rules.grammar, caps, seen, {names[c] for c in rules.required})
+    return decoding.Syntax(tokens, n, arch_tokens(tokens), rules.grammar, rules.caps_by_name, rules.seen_names,
+                           rules.required_names)
 
 
 def arch_tokens(tokens: TokenVocab) -> set[int]:
@@ -130,30 +131,25 @@ def arch_tokens(tokens: TokenVocab) -> set[int]:
     return {k for k, t in enumerate(tokens.tokens) if t.startswith("[") and t[1:-1] in ARCH}
 
 
+def verdicts(rows: np.ndarray, rooms: list[Graph], tokens: TokenVocab, vocab: Vocab, rules: Rules,
+             syntax: decoding.Syntax | None) -> list[tuple[Grown | None, list[str]]]:
+    """Each decoded row's graph in its room, or None and why it is rejected (``dead_end``: the mask left no token to
+    draw; ``unfinished``: no end token within the length; else :func:`to_grown`'s reasons)."""
+    dead, eos = syntax.dead if syntax is not None else set(), tokens.index[EOS]
+    return [(None, ["dead_end"]) if r in dead else (None, ["unfinished"]) if eos not in row
+            else to_grown(tokens.decode(row), room, vocab, rules) for r, (room, row) in enumerate(zip(rooms, rows))]
+
+
 def _sample_valid(net, tokens, vocab, held, n, sc, rules, seed, room_type) -> tuple[dict, int, Counter]:
-    """Graph index -> (valid Grown, seed); how many were valid at the first try; rejections by reason (``unfinished``:
-    no end token within ``max_length``; ``dead_end``: the mask left no token to draw)."""
-    kept, first_try, reasons, eos = {}, 0, Counter(), tokens.index[EOS]
-    pending = list(range(n))
-    for attempt in range(sc["resample_budget"] + 1):
-        for k in progress(range(0, len(pending), sc["batch_size"]), desc=f"strings {room_type}, try {attempt + 1}"):
-            part = pending[k:k + sc["batch_size"]]
-            s = seed + 1_000_003 * attempt + k
-            gen = torch.Generator().manual_seed(s)
-            rooms = [held[i % len(held)] for i in part]
-            z = decoding.prior_codes(len(part), net.to_mu.out_features, gen)
-            syntax = masker(tokens, vocab, len(part), rules, sc["mask"])
-            rows = decoding.decode(net, z, prefixes(rooms, vocab, tokens), tokens, sc["max_length"], sc["temperature"],
-                                   gen, syntax)
-            dead = syntax.dead if syntax is not None else set()
-            for r, (i, room, row) in enumerate(zip(part, rooms, rows)):
-                grown, bad = ((None, ["dead_end"]) if r in dead else (None, ["unfinished"]) if eos not in row
-                              else to_grown(tokens.decode(row), room, vocab, rules))
-                reasons.update(bad)
-                first_try += attempt == 0 and not bad
-                if grown is not None:
-                    kept[i] = (grown, s)
-        pending = [i for i in pending if i not in kept]
-        if not pending:
-            break
-    return kept, first_try, reasons
+    """Graph index -> (valid Grown, seed); how many were valid at the first try; rejections by reason
+    (:func:`verdicts`), drawn again up to the resample budget (:func:`~pipeline.graphs.generated.resample`)."""
+    def draw(part: list[int], s: int) -> list:
+        gen = torch.Generator().manual_seed(s)
+        rooms = [held[i % len(held)] for i in part]
+        z = decoding.prior_codes(len(part), net.to_mu.out_features, gen)
+        syntax = masker(tokens, len(part), rules, sc["mask"])
+        rows = decoding.decode(net, z, prefixes(rooms, vocab, tokens), tokens, sc["max_length"], sc["temperature"],
+                               gen, syntax)
+        return verdicts(rows, rooms, tokens, vocab, rules, syntax)
+
+    return resample(n, sc["resample_budget"], sc["batch_size"], seed, draw, f"strings {room_type}")

@@ -12,7 +12,7 @@ import torch
 from ...graphs.data import EDGE_CLASSES, N_OBJECT_EDGES
 
 from .model import SeqVAE
-from .grammar import Grammar
+from .grammar import Grammar, bonds_of
 from .serialize import Reader, label_fault
 from .vocab import BOS, EOS, PAD, SPECIAL, TokenVocab
 
@@ -102,11 +102,7 @@ class Syntax:
 
     def _held(self, reader: Reader) -> list[Counter]:
         """Every node's bonds so far, at the grammar's detail."""
-        out = [Counter() for _ in reader.names]
-        for s, t, c in reader.edges:
-            out[s][self.grammar.bond(True, c, reader.names[t])] += 1
-            out[t][self.grammar.bond(False, c, reader.names[s])] += 1
-        return out
+        return bonds_of(reader.names, reader.edges, self.grammar.detail)
 
     def _under_cap(self, reader: Reader, name: str) -> bool:
         return reader.names.count(name) < self.caps.get(name, len(reader.names) + 1)

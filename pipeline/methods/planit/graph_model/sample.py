@@ -14,9 +14,8 @@ from ....errors import InputError
 from ....graphs import checks as graph_checks
 from ....graphs import data as graph_data
 from ....graphs.data import ARCH
-from ....graphs.generated import contents_of, graph_rows
+from ....graphs.generated import contents_of, graph_rows, resample
 from ....learning import checkpoint
-from ....log import progress
 from . import train
 from .sampler import sample
 from .spec import load_spec
@@ -51,8 +50,7 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     heldout_ids = set(saved["heldout_ids"])
     train_graphs = [g for g in graphs if g.room_id not in heldout_ids]
     caps, required = contents_of(train_graphs, vocab, sc["contents"])
-    opposite_ok = {int(g.node_class[k]) for g in train_graphs
-                   for k in graph_checks.near_opposite_walls(g.node_class.tolist(), [tuple(e) for e in g.edges.tolist()])}
+    opposite_ok = graph_checks.opposite_classes(train_graphs)
     plan = None
     if spec is not None:
         plan, arch_from = load_spec(spec, room_type, vocab)
@@ -85,21 +83,11 @@ def _sample_valid(net, vocab, held, n, sc, rules, plan, base_seed, max_edges, ro
     caps and the required classes (:func:`contents_of`), and the classes the training graphs show near two opposite
     walls."""
     seen, caps, required, opposite_ok = rules
-    kept, first_try, reasons = {}, 0, Counter()
-    pending = list(range(n))
-    for attempt in range(sc["resample_budget"] + 1):
-        for k in progress(range(0, len(pending), sc["batch_size"]), desc=f"sample {room_type}, try {attempt + 1}"):
-            part = pending[k:k + sc["batch_size"]]
-            seed = base_seed + 1_000_003 * attempt + k
-            grown = sample(net, vocab, [held[i % len(held)] for i in part], seed, sc["temperature"], sc["max_objects"],
-                           max_edges, [plan] * len(part) if plan else None, seen, caps, opposite_ok)
-            for i, g in zip(part, grown):
-                bad = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen, required, opposite_ok)
-                reasons.update(bad)
-                first_try += attempt == 0 and not bad
-                if not bad:
-                    kept[i] = (g, seed)
-        pending = [i for i in pending if i not in kept]
-        if not pending:
-            break
-    return kept, first_try, reasons
+
+    def draw(part: list[int], seed: int) -> list:
+        grown = sample(net, vocab, [held[i % len(held)] for i in part], seed, sc["temperature"], sc["max_objects"],
+                       max_edges, [plan] * len(part) if plan else None, seen, caps, opposite_ok)
+        return [(g, graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen, required, opposite_ok))
+                for g in grown]
+
+    return resample(n, sc["resample_budget"], sc["batch_size"], base_seed, draw, f"sample {room_type}")
