@@ -283,10 +283,40 @@ def test_every_training_graph_reads_back_from_random_strings(bedrooms):
     """Issue 31: parse(serialize(g)) is isomorphic to g for every procedural training graph and random orders."""
     from test_strings import isomorphic
 
-    from pipeline.methods.strings.serialize import parse, serialize, string_graph
+    from pipeline.methods.strings.serialize import arch_prefix, parse, serialize, serialize_room, string_graph
 
     vocab, graphs = bedrooms
     rng = np.random.default_rng(0)
-    for g in map(lambda g: string_graph(g, vocab), graphs):
+    for graph in graphs:
+        g = string_graph(graph, vocab)
         assert len(g.edges) > len(g.names) - 1  # rings: the wall loop at least
         assert all(isomorphic(parse(serialize(g, rng)), g) for _ in range(5)), g
+        prefix = arch_prefix(g, graph.n_arch)[0] + "."
+        assert all((t := serialize_room(g, graph.n_arch, rng)).startswith(prefix) and isomorphic(parse(t), g)
+                   for _ in range(5)), g
+
+
+def test_a_room_string_is_read_back_into_its_room_and_broken_ones_are_rejected_by_cause(bedrooms):
+    """Issue 31: the strings sampler's check (rooms.to_grown) gives a training room's own string back as the same
+    graph in that room's architecture, and rejects a truncated string, an architecture atom written among the
+    objects, a bond no training graph holds and an object standing apart, each by its cause."""
+    from test_strings import isomorphic
+
+    from pipeline.methods.strings.rooms import Rules, to_grown
+    from pipeline.methods.strings.serialize import StringGraph, serialize_room, string_graph
+
+    vocab, graphs = bedrooms
+    rules = Rules(graphs, vocab, "neighbour", {"cap_counts": True, "required_share": 0.95})
+    room = graphs[0]
+    text = serialize_room(string_graph(room, vocab), room.n_arch, np.random.default_rng(1))
+    grown, bad = to_grown(text, room, vocab, rules)
+    assert not bad and grown.arch is room
+    back = StringGraph(tuple(vocab.node_classes[c] for c in grown.node_class), np.array(grown.edges))
+    assert isomorphic(back, string_graph(room, vocab))
+    arch = lambda edges: sorted(e for e in map(tuple, edges) if max(e[:2]) < room.n_arch)
+    assert arch(grown.edges) == arch(room.edges[:, :3].tolist())  # the architecture node for node
+    obj = next(c for c in vocab.categories if c in text)
+    assert to_grown(text[:-3], room, vocab, rules)[1] == ["unparsable"]
+    assert to_grown(text + ".[wall]{>support}@0", room, vocab, rules)[1] == ["unknown_object"]
+    assert to_grown(text + f".[{obj}]{{>support}}@0", room, vocab, rules)[1] == ["grammar"]  # a wall on an object
+    assert "disconnected" in to_grown(text + f".[{obj}]", room, vocab, rules)[1]

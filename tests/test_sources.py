@@ -18,7 +18,7 @@ from pipeline.corpus import front3d
 from pipeline.errors import InputError
 from pipeline.stages import ingest
 from pipeline.graphs import data as graph_data
-from pipeline.methods.strings.serialize import parse, serialize, string_graph
+from pipeline.methods.strings.serialize import arch_prefix, parse, serialize, serialize_room, string_graph
 from test_strings import isomorphic
 from conftest import ROOT, shared_data
 
@@ -160,8 +160,12 @@ def test_front3d_real_sample_runs_through_refinement(tmp_path):
     nodes = pd.read_parquet(tmp_path / "results/graphs/ingested/nodes.parquet")  # issue 31: real graphs as strings
     vocab = graph_data.vocab_of(nodes)
     rng = np.random.default_rng(0)
-    for g in (string_graph(g, vocab) for g in graph_data.graphs_from_tables(nodes, edges, vocab)):
+    for graph in graph_data.graphs_from_tables(nodes, edges, vocab):
+        g = string_graph(graph, vocab)
         assert all(isomorphic(parse(serialize(g, rng)), g) for _ in range(5)), g
+        prefix = arch_prefix(g, graph.n_arch)[0] + "."  # the room strings the VAE learns: architecture first
+        rooms = [serialize_room(g, graph.n_arch, rng) for _ in range(5)]
+        assert all(t.startswith(prefix) and isomorphic(parse(t), g) for t in rooms), g
 
 
 # ----------------------------------------------------------------------------------------------- AI2-THOR
