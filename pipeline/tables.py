@@ -228,6 +228,8 @@ SCHEMAS["scenes"] = pa.schema([
     _f("unplanned_edges", _I32, doc="extracted support or spatial edges at an object that the plan lacks"),
     _f("unplanned_adjacent", _I32, doc="of those, support or adjacent ones"),
     _f("colliding_objects", _I32, doc="objects penetrating another deeper than instantiate.checks.collision"),
+    _f("unanchored_objects", _I32, doc="objects the string method's assembly placed with no placed neighbour (on a "
+       "random free cell); null for the other methods"),
 ])
 SCHEMAS["splits"] = pa.schema([
     _f("room_id", _STR, nullable=False), _f("room_type", _CAT),

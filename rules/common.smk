@@ -47,7 +47,7 @@ wildcard_constraints:
     spec="[A-Za-z0-9_]+",
     room="[A-Za-z0-9_.]+",
     keep="[0-9]+",
-    net="cfcn|fcn",
+    net="|".join(planit_methods.PLACEMENT_LEARNERS),
     method="|".join(config["generation"]["methods"]),
     generator="|".join(planit_methods.GRAPH_SOURCES),
     variant="|".join(v for v, s in config["instantiate"]["variants"].items() if s["graphs"] == "heldout"),
@@ -96,8 +96,8 @@ METHODS = config["generation"]["methods"]
 VARIANTS = config["instantiate"]["variants"]
 GENERATORS = planit_methods.graph_sources_of(METHODS)  # the graph generators the methods place graphs of
 TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldout"]
-# what placement training reads
-PLACEMENT_TRAIN_KEYS = ["preset", f"presets.{config['placement']['preset']}", "device"]
+# the placement learners trained: PlanIT's CFCN (Table 3 places with it) and those the methods read
+PLACEMENT_NETS = list(dict.fromkeys(["cfcn", *planit_methods.placement_nets_of(METHODS)]))
 
 
 def keys(*dotted):
@@ -120,6 +120,11 @@ def generator_train_keys(wildcards):
 def generator_sample_keys(wildcards):
     """Params function: the keys a graph generator's sampling reads."""
     return keys(*planit_methods.graph_source(wildcards.generator).sample_keys(config))
+
+
+def placement_train_keys(wildcards):
+    """Params function: the keys a placement learner's training reads."""
+    return keys(*planit_methods.placement_learner(wildcards.net).train_keys(config))
 
 
 def method_keys(wildcards):
@@ -262,7 +267,7 @@ def learned_outputs(wildcards):
     types = graph_room_types()
     return [
         *expand(GRAPH_MODEL, room_type=types, generator=GENERATORS, name=["metrics.json", "loss.png"]),
-        *expand(PLACEMENT, room_type=types, net="cfcn", name="loss.png"),
+        *expand(PLACEMENT, room_type=types, net=PLACEMENT_NETS, name="loss.png"),
         *expand(GENERATED, room_type=types, method=METHODS, name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
         *expand(EVAL, room_type=types, name="metrics.json"),

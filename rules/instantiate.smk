@@ -19,7 +19,7 @@ rule train_placement:
                      labels={"room type": "{room_type}", "network": "{net}"}),
         summary=PLACEMENT.replace("{name}", "training.json"),
     params:
-        config=keys("seed", *(f"placement.{k}" for k in PLACEMENT_TRAIN_KEYS)),
+        config=placement_train_keys,
         io=stage_io("train_placement"),
     threads: 1  # more per job: set-threads in a profile
     resources:

@@ -7,10 +7,11 @@ import importlib
 from types import SimpleNamespace
 
 from ..errors import InputError
-from .interface import Corpus, Generated, GraphGenerator, GraphSource, LayoutGenerator, Method, Scene, Task
+from .interface import Corpus, Generated, GraphGenerator, GraphSource, LayoutGenerator, Method, PlacementLearner, Scene, Task
 
 __all__ = ["Corpus", "Generated", "GraphGenerator", "GraphSource", "LayoutGenerator", "Method", "Scene", "Task", "register",
-           "get", "names", "load_plugins", "layout_of", "graph_generator", "graph_source", "graph_sources_of"]
+           "get", "names", "load_plugins", "layout_of", "graph_generator", "graph_source", "graph_sources_of", "PlacementLearner", "placement_learner", "placement_fit",
+           "placement_nets_of"]
 
 _METHODS: dict[str, Method] = {}
 
@@ -71,7 +72,23 @@ def graph_sources_of(method_names: list[str]) -> list[str]:
     return list(dict.fromkeys(get(m).graphs for m in method_names if get(m).graphs is not None))
 
 
-from .builtin import BUILTIN, GRAPH_SOURCES  # noqa: E402
+def placement_learner(name: str) -> PlacementLearner:
+    if name not in PLACEMENT_LEARNERS:
+        raise InputError(f"no placement learner '{name}' (known: {', '.join(sorted(PLACEMENT_LEARNERS))})")
+    return PLACEMENT_LEARNERS[name]
+
+
+def placement_fit(name: str):
+    """The ``fit`` function of the placement learner ``name``, imported."""
+    return _load(placement_learner(name).fit)
+
+
+def placement_nets_of(method_names: list[str]) -> list[str]:
+    """The placement learners the named methods read, in their order."""
+    return list(dict.fromkeys(get(m).model for m in method_names if get(m).model is not None))
+
+
+from .builtin import BUILTIN, GRAPH_SOURCES, PLACEMENT_LEARNERS  # noqa: E402
 
 for _m in BUILTIN:
     register(_m)

@@ -2,7 +2,7 @@
 (instantiate.variants of sampled graphs), the string VAE's graphs placed by PlanIT's search, and retrieval."""
 from __future__ import annotations
 
-from .interface import GraphSource, Method
+from .interface import GraphSource, Method, PlacementLearner
 
 
 def _preset_keys(section: str, *more: str):
@@ -19,6 +19,16 @@ GRAPH_SOURCES = {s.name: s for s in [
     GraphSource("strings", "pipeline.methods.strings.fit:fit_room_type", "pipeline.methods.strings.rooms:sample_room_type",
                 "strings_vae", "strings",
                 _preset_keys("strings"), lambda config: ["seed", "strings.sample", "graph_model.sample.contents"]),
+]}
+
+
+PLACEMENT_LEARNERS = {p.name: p for p in [
+    *(PlacementLearner(net, "pipeline.methods.planit.nets.fit:fit_from_tables", _preset_keys("placement"))
+      for net in ("cfcn", "fcn")),
+    PlacementLearner("tagger", "pipeline.methods.strings.tagfit:fit_tagger",
+                     lambda config: ["seed", "strings.tagger.preset",
+                                     f"strings.tagger.presets.{config['strings']['tagger']['preset']}",
+                                     "strings.tagger.device", "strings.tagger.bandwidth"]),
 ]}
 
 
@@ -46,6 +56,11 @@ BUILTIN = [
     _search("unconditional_sampled", "fcn", "the sampled graphs placed with the location network without FiLM"),
     _search("strings", "cfcn", "the string VAE's sampled graphs (Kalojanov et al.) placed by PlanIT's search with the "
             "CFCN", graphs="strings"),
+    Method("strings_tagged", "pipeline.methods.strings.tagged:TaggedLayout", graphs="strings", model="tagger",
+           keys=lambda config, name: ["seed", "extract", "floor_contact", "instantiate", "evaluate.collision.penetration",
+                                      "strings.tagger.placement", "strings.tagger.preset"],
+           description="the string VAE's sampled graphs placed the paper's way: each edge tagged with a relative-pose "
+           "cluster by the edge tagger, assembled breadth-first from the walls with repair"),
     Method("retrieval", "pipeline.methods.retrieval:Retrieval", reference="planit",
            keys=lambda config, name: ["evaluate.render"],
            description="each of PlanIT's rooms replaced by its nearest training room (the memorisation floor)"),

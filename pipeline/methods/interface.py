@@ -125,13 +125,24 @@ class GraphSource:
 
 
 @dataclass(frozen=True)
+class PlacementLearner:
+    """A registered learner of placement (rule ``train_placement``, its ``net`` wildcard): ``fit``
+    (``"module:function"``) is ``fit(config, room_type, net, node_df, edge_df, inputs, split, progress_file, threads)``
+    over one room type's final graph rows and rooms (room id -> RoomInput), returning a ``learning.fitted.Fitted``;
+    ``train_keys(config)``: the dotted config keys it reads."""
+    name: str
+    fit: str
+    train_keys: Callable[[dict], list[str]]
+
+
+@dataclass(frozen=True)
 class Method:
     """A named generator: a layout generator (``layout``: ``"module:factory"``, imported when the method runs;
     ``factory(config, name)`` returns the :class:`LayoutGenerator`) and the inputs its rule gives it."""
     name: str
     layout: str
     graphs: str | None = None  # the graph generator whose sampled graphs it places ("planit", "strings"), or None
-    model: str | None = None  # the placement networks it reads ("cfcn" | "fcn"), or None
+    model: str | None = None  # the placement learner whose checkpoint it reads ("cfcn" | "fcn" | "tagger"), or None
     reference: str | None = None  # the method whose rooms it reads, or None
     keys: Callable[[dict, str], list[str]] = lambda config, name: ["seed"]  # the config keys it reads
     scenes: Callable[[dict, str], int] | None = None  # scenes it generates by default (None: one per held-out room)

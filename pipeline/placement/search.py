@@ -418,6 +418,13 @@ class Search:
         return j
 
 
+def drop_reason(drops: list[dict], planned: int) -> str:
+    """A partial scene's reason: how many of the ``planned`` objects it left out, by cause (:data:`DROP_CAUSES`)."""
+    by_cause = {c: ", ".join(f"{d['id']} ({d['category']})" for d in drops if d["cause"] == c) for c in DROP_CAUSES}
+    return f"dropped {len(drops)} of {planned} objects: " + "; ".join(
+        f"{DROP_CAUSES[c]}: {ids}" for c, ids in by_cause.items() if ids)
+
+
 def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, pool: ModelPool,
                 checker: Checker, cfg: dict, seed: int, poses: PoseRules | None = None) -> Outcome:
     """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed); a floor
@@ -434,9 +441,7 @@ def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int]
             break
     ok = not reason
     if ok and s.dropped:
-        by_cause = {c: ", ".join(f"{d['id']} ({d['category']})" for d in s.drops if d["cause"] == c) for c in DROP_CAUSES}
-        reason = f"dropped {len(s.dropped)} of {len(order)} objects: " + "; ".join(
-            f"{DROP_CAUSES[c]}: {ids}" for c, ids in by_cause.items() if ids)
+        reason = drop_reason(s.drops, len(order))
     total = lambda name: sum(getattr(r, name) for r in runs)
     failures = sum((Counter(r.failures) for r in runs), Counter())
     return Outcome(ok, s.room, reason, time.perf_counter() - start, total("insertions"), total("rejections"),

@@ -80,9 +80,9 @@ _ALL = [
           "beside the sampling floor).", inputs=(one("model"), *GRAPHS, one("gen_nodes"), one("gen_edges"),
                                                  one("sample_summary")),
           outputs=(one("metrics"),), params=(ROOM_TYPE, GENERATOR)),
-    Stage("train_placement", "Train the location and orientation networks of one room type (resumes from the "
-          "checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT), outputs=TRAINING,
-          params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned) or fcn (the unconditional ablation)")),
+    Stage("train_placement", "Train one placement learner of one room type: PlanIT's location and orientation "
+          "networks, or the string method's edge tagger (resumes from the checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT), outputs=TRAINING,
+          params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned), fcn (the unconditional ablation) or tagger (the string method's edge tagger)")),
           threads=True),
     Stage("generate", "Generate rooms of one room type with one method: canonical tables, a record per scene, "
           "GLB / PNG / JSON per scene.",

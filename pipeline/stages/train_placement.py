@@ -1,5 +1,6 @@
-"""Train the placement networks (location CFCN, or the unconditional FCN, and orientation) of one room type on its
-training rooms; one job per room type and net."""
+"""Train one placement learner of one room type on its training rooms and final graphs (the ``net`` wildcard: PlanIT's
+location CFCN or unconditional FCN with the orientation network, or the string method's edge tagger); one job per
+room type and learner."""
 from __future__ import annotations
 
 from .. import tables
@@ -10,16 +11,16 @@ from ..stage import Files
 
 
 def run(config: dict, inp: Files, out: Files, room_type: str, net: str, threads: int = 1) -> dict:
+    from .. import methods
     from ..learning.fitted import write_fitted
-    from ..methods.planit.nets.fit import fit_room_type, training_rooms
 
+    fit = methods.placement_fit(net)
     flt = [("room_type", "=", room_type)]
     node_df = tables.read(inp.nodes, "final_nodes", filters=flt).to_pandas()
     if node_df.empty:
         raise InputError(f"{inp.nodes}: no graph of room type '{room_type}'")
     edge_df = tables.read(inp.edges, "final_edges", filters=flt).to_pandas()
     _, _, _, rooms = load_rooms(inp.rooms, inp.architecture, inp.objects, set(node_df["room_id"]))
-    cats, train_rooms, held_rooms, held_ids = training_rooms(rooms, node_df, edge_df, read_split(inp.split))
-    fitted = fit_room_type(config, room_type, net, cats, train_rooms, held_rooms, held_ids,
-                           out.model.with_name("checkpoint.pt"), threads)
+    fitted = fit(config, room_type, net, node_df, edge_df, rooms, read_split(inp.split),
+                 out.model.with_name("checkpoint.pt"), threads)
     return write_fitted(out, fitted)

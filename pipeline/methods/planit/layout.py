@@ -3,10 +3,9 @@ and orientation networks. One variant of ``instantiate.variants`` per method (pl
 baselines) or per Table 3 ablation (held-out rooms' own graphs)."""
 from __future__ import annotations
 
-import json
 import logging
 import zlib
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Iterator
 
@@ -15,54 +14,18 @@ import torch
 
 from ... import tables
 from ...errors import InputError
-from ...geometry.raycast import intersector_class
 from ...learning import checkpoint
 from ...log import progress
-from ...placement import order, proposers, scene_metrics
-from ...placement.checks import Checker, checks_config
+from ...placement import order, proposers
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
-from ...placement.poses import PoseRules, describe, learn_pose_rules
-from ...placement.support import learn_support_floor
-from ...placement.retrieval import ModelPool
 from ...placement.search import instantiate
 from ..interface import Corpus, Scene, Task
+from ..placing import Context, load_context, scene_of
 from .nets.proposer import NetProposer
 from .nets.train import KIND
 
 log = logging.getLogger("planit.instantiate")
-
-
-@dataclass
-class Context:
-    """Everything the scenes of one room type share."""
-    corpus: Corpus
-    pool: ModelPool
-    checker: Checker
-    mean_area: dict
-    poses: PoseRules | None = None
-
-
-def load_context(config: dict, corpus: Corpus) -> Context:
-    sym_rows = tables.read(corpus.symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
-    sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
-    sizes = tables.read(corpus.category_sizes, "category_sizes").to_pandas()
-    sizes = sizes[sizes["room_type"].astype(str) == corpus.room_type]
-    ext = {**config["extract"], "floor_contact": config["floor_contact"]}
-    training = corpus.training()
-    checks = checks_config(config)
-    floor = learn_support_floor(training, checks, config["floor_contact"])
-    checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor)
-    if floor:
-        log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
-    objs = corpus.objects
-    pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
-    rules = config["instantiate"]["pose_rules"]
-    poses = learn_pose_rules(training, rules) if rules["enabled"] else None
-    if poses is not None:
-        log.info("%s: %d pose rules learned from %d training rooms:\n  %s", corpus.room_type,
-                 len(poses.turns), len(training), "\n  ".join(describe(poses)))
-    return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])), poses)
 
 
 def make_proposer(location: str, saved, cfg: dict):
@@ -88,19 +51,6 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
     start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
     walls = walls_of(start)
     return instantiate(plan, start, walls, seq[keep:], proposer, ctx.pool, ctx.checker, cfg, seed, ctx.poses), walls
-
-
-def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
-    """The searched scene with its search counts and graph consistency (the project's extraction judges it)."""
-    room = outcome.room
-    parents = dict(zip(plan.ids, plan.parent))
-    record = {"seconds": outcome.seconds, "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids),
-              "insertions": outcome.insertions, "rejections": outcome.rejections, "backtracks": outcome.backtracks,
-              "attempts": outcome.attempts, "failures": json.dumps(outcome.failures),
-              "drops": json.dumps(outcome.drops),
-              **scene_metrics.consistency(plan, room, walls.ids, ctx.checker, outcome.dropped, outcome.accepted),
-              "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
-    return Scene(plan.scene_id, plan.room_id, room, walls, outcome.status, outcome.reason, record, plan.edges, parents)
 
 
 def select_plans(config: dict, variant: dict, corpus: Corpus, nodes: Path, edges: Path, count: int) -> list[ScenePlan]:

@@ -106,6 +106,11 @@ def serialize_room(graph: StringGraph, n_arch: int, rng: np.random.Generator | N
     """A room's string, conditioned on its architecture: :func:`arch_prefix` (nodes ``0 .. n_arch - 1``), then
     ``.`` and the objects' components (random orders with ``rng``), each object's bonds to the architecture written
     after its atom as references ``{bond}@k``."""
+    return room_string(graph, n_arch, rng)[0]
+
+
+def room_string(graph: StringGraph, n_arch: int, rng: np.random.Generator | None = None) -> tuple[str, list[int]]:
+    """:func:`serialize_room`'s string and the graph's node of each of its atoms, in the string's order."""
     prefix, arch_order = arch_prefix(graph, n_arch)
     at = {node: k for k, node in enumerate(arch_order)}
     objects = _subgraph(graph, range(n_arch, len(graph.names)))
@@ -114,8 +119,8 @@ def serialize_room(graph: StringGraph, n_arch: int, rng: np.random.Generator | N
         a, o = sorted(pair)
         if a < n_arch <= o:
             refs.setdefault(o - n_arch, []).append(bond_token(_labels(edges, a)) + f"@{at[a]}")
-    body = _serialize(objects, rng, refs)[0]
-    return prefix + ("." + body if body else "")
+    body, atoms = _serialize(objects, rng, refs)
+    return prefix + ("." + body if body else ""), arch_order + [n_arch + a for a in atoms]
 
 
 def arch_prefix(graph: StringGraph, n_arch: int) -> tuple[str, list[int]]:
@@ -197,10 +202,15 @@ def parse(text: str) -> StringGraph:
     Raises :class:`StringError` naming the first malformed token: an unknown edge class, a bond with no atom after
     it, an unclosed branch or ring, a ring closed without a bond, a ``)`` with no ``(``, a reference to no earlier
     atom."""
+    return read_string(text).finish()
+
+
+def read_string(text: str) -> "Reader":
+    """The :class:`Reader` after every token of ``text`` (its ``bond_at`` names each edge's bond token)."""
     reader = Reader()
     for i, tok in enumerate(tokens(text)):
         reader.read(tok, i)
-    return reader.finish()
+    return reader
 
 
 class Reader:
@@ -211,8 +221,10 @@ class Reader:
     def __init__(self):
         self.names: list[str] = []
         self.edges: list[tuple[int, int, int]] = []
+        self.bond_at: list[int] = []  # per edge: the index of the bond token that wrote it
         self.current: int | None = None
         self.bond: str | None = None
+        self.bond_index = -1
         self.branches: list[int] = []
         self.rings: dict[int, tuple[int, int]] = {}  # digit -> (opening atom, token index)
         self.branch_opened = False  # the last token was "(": a bond must come next
@@ -258,19 +270,19 @@ class Reader:
         if tok.startswith("["):
             self.names.append(tok[1:-1])
             if self.bond is not None:
-                self.edges += _edges(self.bond, self.current, len(self.names) - 1)
+                self._bonded(self.current, len(self.names) - 1)
             self.current, self.bond = len(self.names) - 1, None
         elif tok.startswith("{"):
-            self.bond = tok
+            self.bond, self.bond_index = tok, i
         elif tok.startswith("%"):
             k = int(tok[1:])
             if k in self.rings:
-                self.edges += _edges(self.bond, self.rings.pop(k)[0], self.current)
+                self._bonded(self.rings.pop(k)[0], self.current)
             else:
                 self.rings[k] = (self.current, i)
             self.bond = None
         elif tok.startswith("@"):
-            self.edges += _edges(self.bond, int(tok[1:]), self.current)
+            self._bonded(int(tok[1:]), self.current)
             self.bond = None
         elif tok == "(":
             self.branches.append(self.current)
@@ -278,6 +290,11 @@ class Reader:
             self.current = self.branches.pop()
         else:
             self.current = None
+
+    def _bonded(self, earlier: int, later: int) -> None:
+        new = _edges(self.bond, earlier, later)
+        self.edges += new
+        self.bond_at += [self.bond_index] * len(new)
 
     def end_fault(self) -> str | None:
         """Why the string may not end here (None: it may)."""

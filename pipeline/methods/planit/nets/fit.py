@@ -60,6 +60,13 @@ def fit_room_type(config: dict, room_type: str, net: str, cats: tuple, train_roo
     return Fitted(ckpt, frame, summary, _curve(frame, room_type, net))
 
 
+def fit_from_tables(config: dict, room_type: str, net: str, node_df: pd.DataFrame, edge_df: pd.DataFrame,
+                    inputs: dict, split: dict[str, str], progress_file: Path, threads: int = 1) -> Fitted:
+    """:func:`fit_room_type` on one room type's final graph rows and rooms (the placement learners' signature)."""
+    cats, train_rooms, held_rooms, held_ids = training_rooms(inputs, node_df, edge_df, split)
+    return fit_room_type(config, room_type, net, cats, train_rooms, held_rooms, held_ids, progress_file, threads)
+
+
 def _ticker(room_type: str, net: str, preset: dict):
     bar = iter(progress(range(preset["steps"] // preset["log_every"] + 1), desc=f"train placement {room_type} ({net})"))
 

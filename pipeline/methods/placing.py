@@ -1,0 +1,66 @@
+"""What every layout generator that places objects with the project's placement checks shares (PlanIT's search, the
+string method's assembly): the context of one room type's scenes (model pool, checker, learned pose rules and
+support shares) and a searched scene as a :class:`~pipeline.methods.interface.Scene` with its search counts and
+graph consistency. No torch."""
+from __future__ import annotations
+
+import json
+import logging
+from dataclasses import dataclass
+
+from .. import tables
+from ..geometry.raycast import intersector_class
+from ..placement import scene_metrics
+from ..placement.checks import Checker, checks_config
+from ..placement.plan import ScenePlan
+from ..placement.poses import PoseRules, describe, learn_pose_rules
+from ..placement.retrieval import ModelPool
+from ..placement.support import learn_support_floor
+from .interface import Corpus, Scene
+
+log = logging.getLogger("planit.instantiate")
+
+
+@dataclass
+class Context:
+    """Everything the scenes of one room type share."""
+    corpus: Corpus
+    pool: ModelPool
+    checker: Checker
+    mean_area: dict
+    poses: PoseRules | None = None
+
+
+def load_context(config: dict, corpus: Corpus) -> Context:
+    sym_rows = tables.read(corpus.symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
+    sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
+    sizes = tables.read(corpus.category_sizes, "category_sizes").to_pandas()
+    sizes = sizes[sizes["room_type"].astype(str) == corpus.room_type]
+    ext = {**config["extract"], "floor_contact": config["floor_contact"]}
+    training = corpus.training()
+    checks = checks_config(config)
+    floor = learn_support_floor(training, checks, config["floor_contact"])
+    checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor)
+    if floor:
+        log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
+    objs = corpus.objects
+    pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
+    rules = config["instantiate"]["pose_rules"]
+    poses = learn_pose_rules(training, rules) if rules["enabled"] else None
+    if poses is not None:
+        log.info("%s: %d pose rules learned from %d training rooms:\n  %s", corpus.room_type,
+                 len(poses.turns), len(training), "\n  ".join(describe(poses)))
+    return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])), poses)
+
+
+def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
+    """The searched scene with its search counts and graph consistency (the project's extraction judges it)."""
+    room = outcome.room
+    parents = dict(zip(plan.ids, plan.parent))
+    record = {"seconds": outcome.seconds, "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids),
+              "insertions": outcome.insertions, "rejections": outcome.rejections, "backtracks": outcome.backtracks,
+              "attempts": outcome.attempts, "failures": json.dumps(outcome.failures),
+              "drops": json.dumps(outcome.drops),
+              **scene_metrics.consistency(plan, room, walls.ids, ctx.checker, outcome.dropped, outcome.accepted),
+              "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
+    return Scene(plan.scene_id, plan.room_id, room, walls, outcome.status, outcome.reason, record, plan.edges, parents)
