@@ -8,11 +8,20 @@ CORES ?= 2
 
 .PHONY: setup browser pipeline test test-slurm bench clean
 
-setup: $(VENV)/.installed
+VIEWER := pipeline/viewer
+
+setup: $(VENV)/.installed $(VIEWER)/node_modules/.installed
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet -e '.[test,slurm]'
+	touch $@
+
+# three.js for the room viewer (planit view, the report's 3D gallery), pinned in its package-lock.json; each page
+# inlines it, so nothing is fetched when a page opens
+$(VIEWER)/node_modules/.installed: $(VIEWER)/package-lock.json
+	@command -v npm >/dev/null || { echo "npm (Node.js) is needed for the room viewer: install it (Debian: apt-get install npm)"; exit 1; }
+	npm ci --prefix $(VIEWER) --no-audit --no-fund --loglevel=error
 	touch $@
 
 pipeline: setup

@@ -1,5 +1,5 @@
 """The ``planit`` command line: one subcommand per pipeline stage, named as its module and its Snakemake rule and
-built from its declaration (``pipeline.stages.STAGES``), and ``stats``.
+built from its declaration (``pipeline.stages.STAGES``), ``stats`` and ``view``.
 
 A stage command takes files: its inputs and outputs are exactly the rule's ``{input}`` and ``{output}``. Domain
 errors (a bad table, config, input file or missing backend) end in one line naming the file and field, exit code 2;
@@ -94,10 +94,19 @@ def _stage_command(stage: Stage):
         if stage.threads:
             params["threads"] = values["threads"]
         _print(_stage(module.run, values["config"], values["config_json"], inp, out, **params))
+        _wrote([values["out_" + p.name] for p in stage.outputs])
 
     command.__signature__ = inspect.Signature(_options(stage))
     command.__doc__ = stage.help
     return command
+
+
+def _wrote(paths: list) -> None:
+    """Where a stage wrote: each output file it left (one line)."""
+    flat = [Path(p) for x in paths for p in (x if isinstance(x, (list, tuple)) else [x]) if p is not None]
+    done = [str(p) for p in flat if p.exists()]
+    if done:
+        typer.echo("wrote " + " ".join(done))
 
 
 def _print(result) -> None:
@@ -139,6 +148,58 @@ def stats(path: Path = typer.Argument(..., help="a pipeline Parquet table, a fol
     from .stats import table_summary
 
     _guard(table_summary, path, sys.stdout)
+
+
+def _planned_graph(folder: Path) -> tuple[Path, Path] | None:
+    """The sampled graph tables a generated method's folder (results/generated/<type>/<method>) was planned from."""
+    from . import methods
+
+    name, room_type, results = folder.name, folder.parent.name, folder.parents[2] if len(folder.parents) > 2 else Path(".")
+    if name not in methods.names() or methods.get(name).graphs is None:
+        return None
+    base = results / "graph_model" / room_type / methods.get(name).graphs / "sampled"
+    return (base / "nodes.parquet", base / "edges.parquet") if (base / "edges.parquet").exists() else None
+
+
+def _view_payload(path: Optional[Path], room: Optional[str], scene: str, results: Path, config: Optional[Path]) -> dict:
+    from .viewer import sources
+
+    if (path is None) == (room is None):
+        _fail("planit view: give a generated method's folder (results/generated/<type>/<method>) or --room ID")
+    if room is not None:
+        return sources.ingested_room(results, room)
+    if not path.is_dir():
+        _fail(f"{path}: no such folder (a generated method's folder: results/generated/<type>/<method>)")
+    cfg = config_mod.load(config) if config else config_mod.validate({})
+    return sources.generated_room(path, scene, _planned_graph(path), {**cfg["extract"], "floor_contact": cfg["floor_contact"]})
+
+
+@app.command()
+def view(path: Optional[Path] = typer.Argument(None, help="a generated method's folder: results/generated/<type>/<method>"),
+         room: Optional[str] = typer.Option(None, "--room", help="an ingested room's id (with its final graph)"),
+         scene: str = typer.Option("0", "--scene", help="a generated scene: its id, or its index among the placed ones"),
+         results: Path = typer.Option(Path("results"), "--results", help="the run's results folder (for --room)"),
+         out: Optional[Path] = typer.Option(None, "--out", help="the page to write (default results/view/<room>.html)"),
+         serve: bool = typer.Option(False, "--serve", help="serve the page over HTTP until Ctrl-C"),
+         host: str = typer.Option("127.0.0.1", "--host", help="where --serve listens (0.0.0.0: every interface)"),
+         port: int = typer.Option(8000, "--port", help="--serve's port (0: any free one)"),
+         config: Optional[Path] = ConfigOpt) -> None:
+    """Write a room and its relation graph as a 3D page (three.js, self-contained: opens from file://) and print its
+    path; with --serve, also serve it on 127.0.0.1."""
+    from .tables import write_atomic
+    from .viewer.page import page
+
+    data = _guard(_view_payload, path, room, scene, results, config)
+    target = out or results / "view" / f"{data['room_id']}.html"
+    html = _guard(page, [data], data["title"])
+    target.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(target, lambda tmp: Path(tmp).write_text(html))
+    typer.echo(f"wrote {target} ({len(data['objects'])} objects, "
+               f"{sum(len(g) for g in data['graphs'].values())} edges over {len(data['graphs'])} graph(s))")
+    if serve:
+        from .viewer.serve import serve as serve_page
+
+        serve_page(target, host, port, typer.echo)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -62,8 +62,8 @@ def one(name: str, help: str = "", optional: bool = False) -> Port:
     return Port(name, False, optional, help)
 
 
-def many(name: str, help: str = "one per shard") -> Port:
-    return Port(name, True, False, help)
+def many(name: str, help: str = "one per shard", optional: bool = False) -> Port:
+    return Port(name, True, optional, help)
 
 
 def option(port: Port, output: bool) -> str:

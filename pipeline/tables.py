@@ -207,6 +207,9 @@ SCHEMAS["generated_edges"] = pa.schema([*SCHEMAS["final_edges"], *_GENERATED])
 SCHEMAS["generated_objects"] = pa.schema([*SCHEMAS["objects"], _f("scene_id", _STR, doc="generated scene (= room_id)")])
 SCHEMAS["scenes"] = pa.schema([
     _f("scene_id", _STR, nullable=False), _f("room_type", _CAT), _f("variant", _CAT, doc="instantiate.variants key"),
+    _f("origin_id", _STR, doc="what the scene grew from: the sampled graph it placed (its scene_id in the graph "
+       "generator's tables), or the reference scene it stands for (retrieval); the scene's id is the method's name "
+       "and this"),
     _f("source_room_id", _STR, doc="the room whose architecture (and, for held-out graphs, graph) the scene uses"),
     _f("status", _CAT, doc="placed | partial (objects dropped: instantiate.on_exhausted) | failed"),
     _f("reason", _STR, doc="why the search failed, or which objects a partial scene dropped"),

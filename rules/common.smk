@@ -270,5 +270,5 @@ def learned_outputs(wildcards):
         *expand(PLACEMENT, room_type=types, net=PLACEMENT_NETS, name="loss.png"),
         *expand(GENERATED, room_type=types, method=METHODS, name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
-        *expand(EVAL, room_type=types, name="metrics.json"),
+        *expand(EVAL, room_type=types, name=["metrics.json", "gallery3d.html"]),
     ]

@@ -43,6 +43,39 @@ rule evaluate:
         STAGE
 
 
+rule gallery_3d:
+    input:
+        generated_scenes=expand(GENERATED, method=METHODS, name="scenes.parquet", allow_missing=True),
+        generated_rooms=expand(GENERATED, method=METHODS, name="rooms.parquet", allow_missing=True),
+        generated_architecture=expand(GENERATED, method=METHODS, name="architecture.parquet", allow_missing=True),
+        generated_objects=expand(GENERATED, method=METHODS, name="objects.parquet", allow_missing=True),
+        generated_models=expand(GENERATED, method=METHODS, name="models.parquet", allow_missing=True),
+        sampled_nodes=expand(GRAPH_MODEL, generator=GENERATORS, name="sampled/nodes.parquet", allow_missing=True),
+        sampled_edges=expand(GRAPH_MODEL, generator=GENERATORS, name="sampled/edges.parquet", allow_missing=True),
+        rooms=shards_of(FILTER_ROOMS),
+        architecture=shards_of(INGEST, table="architecture"),
+        objects=shards_of(INGEST, table="objects"),
+        models=shards_of(INGEST, table="models"),
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+        split=SPLIT,
+    output:
+        page=report(EVAL.replace("{name}", "gallery3d.html"), caption="../report/gallery3d.rst", category="6. Gallery",
+                    subcategory="{room_type}", labels={"room type": "{room_type}", "figure": "3D gallery"}),
+    params:
+        config=keys("seed", "extract", "floor_contact", "evaluate.gallery", "generation.plugins"),
+        io=stage_io("gallery_3d"),
+    threads: 1
+    log:
+        "logs/gallery_3d/{room_type}.log",
+    benchmark:
+        "benchmarks/gallery_3d/{room_type}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
+
+
 rule runtime:
     input:
         corpus=CORPUS_OUTPUTS,

@@ -216,7 +216,7 @@ def test_the_string_vae_is_a_second_graph_generator_with_its_own_model_graphs_an
         assert placed["variant"] == "strings" and placed["scenes"] <= summary["written"]
         scenes = pd.read_parquet(run_dir / "results" / "generated" / room_type / "strings" / "scenes.parquet")
         sampled = pd.read_parquet(folder / "sampled" / "nodes.parquet")
-        assert set(scenes["scene_id"]) <= set(sampled["scene_id"])
+        assert set(scenes["origin_id"]) <= set(sampled["scene_id"])
 
 
 def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_path):
@@ -360,6 +360,7 @@ def test_the_report_renders_in_headless_chromium_and_its_gallery_images_load(run
         browser.open(report.as_uri())
         browser.click_text("6. Gallery")
         browser.click_text("bedroom")
+        browser.click_text("gallery")  # two figures per room type (the PNG and the 3D page) are a toggle
         images = ("return Array.from(document.images).filter(i => i.src.startsWith('data:image/png'))"
                   ".map(i => [i.src.split(';')[2], i.complete, i.naturalWidth])")
         before = browser.run(images)
@@ -450,6 +451,68 @@ def test_the_report_shows_every_method_beside_the_real_rooms_with_intervals(run_
     walk = metrics["sets"]["planit"]["walkable_share"]
     low, high = metrics["sets"]["planit"]["intervals"]["walkable_share"]
     assert table["planit"]["walkable_share"].startswith(f"{walk:.4g} [{low:.4g}, {high:.4g}]")  # a known number
+
+
+def test_the_reports_3d_gallery_draws_generated_and_real_rooms_in_chromium(run_dir, tmp_path):
+    """The 3D gallery opened from the report (an iframe on a data: URL, no server): three.js draws the first room,
+    the room list holds each method's first placed scenes and the held-out real rooms, and a generated room offers
+    its planned graph, the extracted one and their difference."""
+    browser = _browser(tmp_path)
+    try:
+        _show_in_frame(browser, _report(run_dir), ["6. Gallery", "bedroom", "3D gallery"],
+                       lambda: browser.elements("tbody tr a[iconname='eye']")[0])
+        state = browser.wait_for(lambda: browser.run("return window.viewer && window.viewer.state.drawn && "
+                                                     "window.viewer.state.frames > 2 ? window.viewer.state : null"), 60)
+        titles = browser.run("return [...document.querySelectorAll('#room option')].map(o => o.textContent)")
+        graphs = browser.run("return [...document.querySelectorAll('#graph option')].map(o => o.textContent)")
+    finally:
+        browser.close()
+    assert state and state["objects"] > 0 and state["edges"] > 0
+    assert sum("held-out real" in t for t in titles) >= 1 and sum("planit" in t for t in titles) >= 1
+    assert graphs == ["difference", "planned", "extracted"]
+
+
+def test_planit_view_writes_a_page_for_a_generated_scene_and_a_real_room(run_dir):
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    run = lambda *a: subprocess.run([sys.executable, "-m", "pipeline", "view", *a], cwd=run_dir, capture_output=True,
+                                    text=True, env=env)
+    got = run("results/generated/bedroom/planit", "--scene", "0")
+    scenes = pd.read_parquet(run_dir / "results/generated/bedroom/planit/scenes.parquet")
+    first = scenes.loc[scenes["status"].isin(["placed", "partial"]), "scene_id"].iloc[0]
+    assert got.returncode == 0 and f"wrote results/view/{first}.html" in got.stdout
+    assert (run_dir / f"results/view/{first}.html").stat().st_size > 100_000
+    room = pd.read_parquet(run_dir / "results/graphs/ingested/nodes.parquet")["room_id"].iloc[0]
+    got = run("--room", room, "--out", "results/view/real.html")
+    assert got.returncode == 0 and "1 graph(s)" in got.stdout and (run_dir / "results/view/real.html").exists()
+    bad = run("--room", "no_such_room")
+    assert bad.returncode == 2 and "no room 'no_such_room'" in bad.stderr
+    bad = run("results/generated/bedroom/planit", "--scene", "999")
+    assert bad.returncode == 2 and "scenes.parquet: no placed scene '999'" in bad.stderr
+
+
+def test_writing_commands_say_where_they_wrote_and_scene_ids_are_never_shared(run_dir, tmp_path):
+    """``planit sample_graphs`` run by hand prints the files it wrote; across the run, no two methods' scenes and no
+    generated scene and corpus room share an id, and each scene names the graph it grew from."""
+    res = run_dir / "results"
+    out = {t: tmp_path / f"{t}.parquet" for t in ("nodes", "edges")}
+    got = subprocess.run([sys.executable, "-m", "pipeline", "sample_graphs", "--model", str(res / "graph_model/bedroom/planit/model.pt"),
+                          "--nodes", str(res / "graphs/ingested/nodes.parquet"), "--edges", str(res / "graphs/ingested/edges.parquet"),
+                          "--out-nodes", str(out["nodes"]), "--out-edges", str(out["edges"]), "--out-summary",
+                          str(tmp_path / "s.json"), "--room-type", "bedroom", "--generator", "planit"],
+                         cwd=run_dir, capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert got.returncode == 0, got.stderr
+    assert f"wrote {out['nodes']} {out['edges']} {tmp_path / 's.json'}" in got.stdout
+    ids, corpus = {}, set(pd.read_parquet(res / "graphs/ingested/nodes.parquet")["room_id"])
+    for folder in sorted((res / "generated" / "bedroom").iterdir()):
+        if (folder / "scenes.parquet").exists():
+            scenes = pd.read_parquet(folder / "scenes.parquet")
+            assert scenes["scene_id"].str.startswith(folder.name + "_").all() and scenes["origin_id"].notna().all()
+            ids[folder.name] = set(scenes["scene_id"])
+    assert len(ids) >= 6 and sum(map(len, ids.values())) == len(set().union(*ids.values()))
+    assert not set().union(*ids.values()) & corpus
+    planit = pd.read_parquet(res / "generated/bedroom/planit/scenes.parquet")
+    sampled = set(pd.read_parquet(res / "graph_model/bedroom/planit/sampled/nodes.parquet")["scene_id"])
+    assert set(planit["origin_id"]) <= sampled
 
 
 def test_invalid_config_names_the_key_in_one_line(tmp_path):

@@ -282,6 +282,60 @@ def test_the_glb_reloads_with_one_node_per_object_wall_and_the_floor(tmp_path):
     assert (tmp_path / "s0.png").stat().st_size > 5000
 
 
+def _window(r: Room, element_id, p0, p1, wall_id, z0=0.9, z1=2.1) -> Room:
+    """A window on a hand-built room, the way ``Room.door`` adds a door."""
+    r.openings.append({"room_id": r.room_id, "element_id": element_id, "kind": "window", "x0": p0[0], "y0": p0[1],
+                       "x1": p1[0], "y1": p1[1], "z0": z0, "z1": z1, "thickness": None, "wall_id": wall_id})
+    return r
+
+
+def _world_meshes(scene) -> dict:
+    """Each geometry node of a loaded scene as a mesh in world coordinates (its scene-graph transform applied)."""
+    out = {}
+    for node in scene.graph.nodes_geometry:
+        matrix, geom = scene.graph.get(node)
+        out[node] = scene.geometry[geom].copy().apply_transform(matrix)
+    return out
+
+
+def test_the_glb_is_y_up_and_holds_doors_windows_and_what_each_node_is():
+    """A viewer reads glTF as y-up: the floor faces +y, the walls rise to the room height along +y; every door and
+    window is a node named by its element id on its wall; node extras say what each node is."""
+    import json
+    import struct
+
+    r = Room([(0, 0), (4, 0), (4, 3.5), (0, 3.5)], height=2.7)
+    r.add("bed", "bed", SIZES["bed"], (2.0, 2.4)).add("ns", "nightstand", SIZES["nightstand"], (0.6, 3.2))
+    r.door("door_0", (3.0, 0.0), (3.9, 0.0), "wall_0")
+    _window(r, "win_0", (4.0, 1.0), (4.0, 2.2), "wall_1")
+    room = r.room_input()
+    walls = walls_of(room)
+    raw = export.glb(room, walls, r.models.get)
+    back = trimesh.load(io.BytesIO(raw), file_type="glb")
+    assert set(back.graph.nodes_geometry) == {"bed", "ns", "door_0", "win_0", "floor"} | set(walls.ids)
+    world = _world_meshes(back)
+    floor = world["floor"]
+    up = floor.face_normals @ [0.0, 1.0, 0.0] > 0.999
+    assert floor.area_faces[up].sum() == pytest.approx(4 * 3.5)  # the floor's top faces +y
+    assert floor.bounds[0, 1] == pytest.approx(0.0, abs=0.03) and floor.bounds[1, 1] == pytest.approx(0.0, abs=1e-6)
+    assert max(world[w].bounds[1, 1] for w in walls.ids) == pytest.approx(2.7)
+    assert min(world[w].bounds[0, 1] for w in walls.ids) == pytest.approx(0.0)
+    nodes = json.loads(raw[20:20 + struct.unpack("<I", raw[12:16])[0]])["nodes"]
+    extras = {n["name"]: n.get("extras", {}) for n in nodes}
+    for oid, cat, model in zip(room.object_ids, room.categories, room.model_ids):
+        assert extras[oid] == {"category": cat, "model_id": model, "object_id": oid}
+    assert all(extras[w] == {"kind": "wall"} for w in walls.ids) and extras["floor"] == {"kind": "floor"}
+    assert extras["door_0"] == {"kind": "door"} and extras["win_0"] == {"kind": "window"}
+    for o in room.openings:  # in plan, project (x, y) is glTF (x, -z); heights are glTF y
+        v = world[o["element_id"]].vertices
+        plan, a, b = np.column_stack([v[:, 0], -v[:, 2]]), np.array([o["x0"], o["y0"]]), np.array([o["x1"], o["y1"]])
+        d = (b - a) / np.linalg.norm(b - a)
+        along, across = (plan - a) @ d, np.abs((plan - a) @ [-d[1], d[0]])
+        assert along.min() == pytest.approx(0.0, abs=1e-6) and along.max() == pytest.approx(np.linalg.norm(b - a))
+        assert across.max() <= 0.15 + 0.05 + 1e-6  # within the wall's thickness (and the 5 cm that make it show)
+        assert v[:, 1].min() == pytest.approx(o["z0"]) and v[:, 1].max() == pytest.approx(o["z1"])
+
+
 def test_chains_are_placed_as_units_and_support_after_the_floor():
     edges = [PlanEdge("wall_0", "a", "spatial", "front", "adjacent"), PlanEdge("a", "b", "spatial", "right", "adjacent"),
              PlanEdge("b", "c", "spatial", "right", "adjacent"), PlanEdge("wall_1", "x", "spatial", "front", "proximal"),

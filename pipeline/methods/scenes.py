@@ -7,11 +7,12 @@ from __future__ import annotations
 
 import json
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import pandas as pd
 
 from .. import tables
+from ..errors import InputError
 from ..placement import export
 from ..placement.search import SCORED
 from ..room import BOX_COLUMNS
@@ -123,12 +124,22 @@ def _round(value, digits: int):
     return None if pd.isna(value) else round(float(value), digits)
 
 
+def named(scene: Scene, method: str, corpus: Corpus) -> Scene:
+    """The scene under its id in the method's tables: the method's name first (no two methods' rooms share an id),
+    its origin (the sampled graph it placed, the reference scene it retrieved for) kept as ``origin_id``."""
+    sid = scene.scene_id if scene.scene_id.startswith(f"{method}_") else f"{method}_{scene.scene_id}"
+    if sid in corpus.inputs:
+        raise InputError(f"generated scene id '{sid}' is the id of a {corpus.room_type} room of the corpus")
+    return replace(scene, scene_id=sid, record={"origin_id": scene.scene_id, **scene.record})
+
+
 def write_generated(scenes, corpus: Corpus, method: str, out, meshes: dict, desc: str = "") -> dict:
     """Write every scene of ``scenes`` (an iterator, consumed here) and the method's tables; returns the summary
     (``out``: rooms, architecture, objects, models, scenes, summary, archive)."""
     rows = Rows()
     with tables.write_archive(out.archive) as archive:
         for scene in scenes:
+            scene = named(scene, method, corpus)
             record = rows.add(scene, corpus, method)
             if scene.status != "placed":
                 log.warning("scene %s %s: %s", scene.scene_id, scene.status, scene.reason)

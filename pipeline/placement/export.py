@@ -1,5 +1,10 @@
-"""A generated room as files a person opens: a GLB (one node per object, named by its id, with its category in the
-node's extras; walls and floor included) and a top-down PNG with the planned graph drawn over it."""
+"""A generated room as files a person opens: a GLB and a top-down PNG with the planned graph drawn over it.
+
+The GLB follows glTF's axes, +y up: the project's z-up geometry hangs under one root node ``room`` whose transform
+maps project (x, y, z) to glTF (x, z, -y) (-90 degrees about x), so a viewer shows the floor at y = 0 and the walls
+rising along +y. Under the root: ``floor``, one node per wall, door or window (its element id) and one per object (its
+id). Node extras (the glTF ``nodes[i].extras``): ``{"kind": "floor"}``, ``{"kind": "wall"}``, ``{"kind": "door"}`` or
+``{"kind": "window"}``, and for an object ``{"category", "model_id", "object_id"}``."""
 from __future__ import annotations
 
 import numpy as np
@@ -10,37 +15,77 @@ from ..geometry.boxes import footprint_corners
 from .plan import PlanEdge
 
 EDGE_COLOURS = {"support": "black", "adjacent": "tab:red", "proximal": "tab:orange", "distant": "tab:blue"}
+ROOT = "room"
+Z_UP_TO_Y_UP = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])  # (x, y, z) -> (x, z, -y)
+OPENING_MARGIN = 0.05  # an opening's box is this much thicker than its wall, so it shows through both faces
+DEFAULT_THICKNESS = 0.1
 
 
-def room_scene(room: RoomInput, walls: Walls, mesh_of):
-    """A trimesh Scene of the room: ``floor``, one node per wall (its id) and per object (its id)."""
+def floor_mesh(outline: np.ndarray) -> meshes.Mesh:
+    """A 2 cm slab under the ``(k, 2)`` outline, its top at z = 0."""
     import shapely
-    import trimesh
 
-    scene = trimesh.Scene()
-    tris = shapely.constrained_delaunay_triangles(shapely.Polygon(room.outline))  # GEOS: no extra triangulation engine
-    corners = np.array([np.asarray(t.exterior.coords)[:3] for t in tris.geoms])
+    tris = shapely.constrained_delaunay_triangles(shapely.Polygon(outline))  # GEOS: no extra triangulation engine
+    corners = np.array([np.asarray(t.exterior.coords)[:3] for t in tris.geoms])  # (t, 3, 2)
     d1, d2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
     clockwise = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0] < 0
     corners[clockwise] = corners[clockwise, ::-1]  # prisms take counter-clockwise outlines
-    v, f = meshes.prisms(corners, -0.02, 0.0)
-    scene.add_geometry(trimesh.Trimesh(v, f, process=False), node_name="floor", geom_name="floor", metadata={"kind": "floor"})
+    return meshes.prisms(corners, -0.02, 0.0)
+
+
+def opening_mesh(opening: dict, walls: Walls) -> meshes.Mesh:
+    """A door or window as a box over its segment, from z0 to z1, through the nearest wall and 5 cm thicker.
+
+    Its depth is the opening's ``thickness`` or else the nearest wall's; it is centred on the wall's middle, behind
+    the inner face (``(w, 2)`` normals point into the room)."""
+    p0, p1 = np.array([opening["x0"], opening["y0"]], float), np.array([opening["x1"], opening["y1"]], float)
+    mid, length = (p0 + p1) / 2, float(np.linalg.norm(p1 - p0))
+    d = (p1 - p0) / max(length, 1e-9)
+    normal, thick = np.array([-d[1], d[0]]), DEFAULT_THICKNESS
+    if len(walls.ids):
+        t = np.clip(np.einsum("wi,wi->w", mid - walls.a, walls.dir) / walls.length, 0.0, 1.0)
+        k = int(np.argmin(np.linalg.norm(walls.a + t[:, None] * (walls.b - walls.a) - mid, axis=1)))
+        normal = normal if normal @ walls.normal[k] >= 0 else -normal
+        thick = float(walls.thickness[k])
+    if opening.get("thickness") is not None and np.isfinite(opening["thickness"]):
+        thick = float(opening["thickness"])
+    z0, z1 = float(opening["z0"]), float(opening["z1"])
+    v, f = meshes.box((length, thick + OPENING_MARGIN, z1 - z0), (0.0, 0.0, (z0 + z1) / 2))
+    centre = mid - normal * thick / 2
+    return meshes.transform(v, (centre[0], centre[1], 0.0), float(np.arctan2(d[1], d[0]))), f
+
+
+def _add(scene, name: str, mesh: meshes.Mesh, extras: dict) -> None:
+    """One node ``name`` under the root, its mesh ``(vertices (n, 3), faces (m, 3))`` z-up, ``extras`` on the node."""
+    import trimesh
+
+    geom = trimesh.Trimesh(mesh[0], mesh[1], process=False)
+    geom.metadata.update(extras)
+    scene.add_geometry(geom, node_name=name, geom_name=name, parent_node_name=ROOT, metadata=dict(extras))
+
+
+def room_scene(room: RoomInput, walls: Walls, mesh_of):
+    """A trimesh Scene of the room, y-up: root ``room`` over ``floor``, walls, doors, windows and objects."""
+    import trimesh
+
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from=scene.graph.base_frame, frame_to=ROOT, matrix=Z_UP_TO_Y_UP)
+    _add(scene, "floor", floor_mesh(room.outline), {"kind": "floor"})
     for wid, corners in zip(walls.ids, wall_footprints(walls)):
-        v, f = meshes.prisms(corners[None], 0.0, walls.height)
-        scene.add_geometry(trimesh.Trimesh(v, f, process=False), node_name=wid, geom_name=wid, metadata={"kind": "wall"})
+        _add(scene, wid, meshes.prisms(corners[None], 0.0, walls.height), {"kind": "wall"})
+    for o in room.openings:
+        _add(scene, str(o["element_id"]), opening_mesh(o, walls), {"kind": str(o["kind"])})
     for oid, cat, model, pose in zip(room.object_ids, room.categories, room.model_ids, room.poses):
         mesh = mesh_of(model)
         if mesh is None or not len(mesh[1]):
             continue
         v = meshes.transform(mesh[0], pose[:3], pose[3], pose[4:])
-        geom = trimesh.Trimesh(v, mesh[1], process=False)
-        geom.metadata.update({"category": cat, "model_id": model})
-        scene.add_geometry(geom, node_name=oid, geom_name=oid, metadata={"category": cat, "model_id": model})
+        _add(scene, oid, (v, mesh[1]), {"category": cat, "model_id": model, "object_id": oid})
     return scene
 
 
 def glb(room: RoomInput, walls: Walls, mesh_of) -> bytes:
-    """The room as a binary glTF (``room_scene``)."""
+    """The room as a binary glTF, y-up (``room_scene``)."""
     return room_scene(room, walls, mesh_of).export(file_type="glb")
 
 

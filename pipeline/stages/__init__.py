@@ -123,6 +123,13 @@ _ALL = [
                    one("power", "the classifier's power check (PNG)"),
                    one("gallery", "generated and held-out real rooms side by side (PNG)")), params=(ROOM_TYPE,),
           threads=True),
+    Stage("gallery_3d", "The gallery's rooms in 3D: each method's first placed scenes (planned graph, the graph "
+          "extraction finds, their difference) and held-out real rooms (final graph) in one self-contained viewer page.",
+          inputs=(many("generated_scenes", "one per method (its folder holds the method's tables)"),
+                  many("generated_rooms"), many("generated_architecture"), many("generated_objects"),
+                  many("generated_models"), many("sampled_nodes", "the graph generators' sampled graphs", optional=True),
+                  many("sampled_edges", optional=True), *CORPUS_SHARDS, *GRAPHS, SPLIT),
+          outputs=(one("page", "the viewer page (HTML, three.js inlined)"),), params=(ROOM_TYPE,)),
     Stage("runtime", "Job seconds and peak memory per rule from the benchmark files, and the run's wall-clock span.",
           inputs=(many("corpus", "the corpus stages' outputs (their jobs are timed; read for their presence)"),
                   many("learned", "the learned room types' outputs (likewise)")),
