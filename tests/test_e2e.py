@@ -163,13 +163,13 @@ def test_forcerun_refine_reruns_only_refinement_and_after(run_dir):
 def test_a_sampling_setting_resamples_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\n"
                                             "graph_model:\n  sample: {graphs: 20, batch_size: 20, temperature: 0.8}\n")
-    assert jobs == {"sample_graphs", "graph_model_metrics", "generate", "evaluate", "runtime"}  # placed, scored again
+    assert jobs == {"sample_graphs", "graph_model_metrics", "generate", "evaluate", "gallery_3d", "runtime"}  # placed, scored again
 
 
 def test_a_search_setting_replaces_without_retraining(run_dir, tmp_path):
     jobs = _dry_run_with(run_dir, tmp_path, "refine:\n  hub_min_pattern_count: 1\ninstantiate:\n  samples: 12\n",
                          "all", TABLE3)
-    assert jobs == {"generate", "instantiate", "table3", "evaluate", "runtime"}  # the placement networks are kept
+    assert jobs == {"generate", "instantiate", "table3", "evaluate", "gallery_3d", "runtime"}  # the placement networks are kept
 
 
 def test_graph_models_are_trained_sampled_and_evaluated_per_room_type(run_dir):
@@ -264,7 +264,7 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
     from pipeline.corpus.procedural_rules import RULES
 
     res = run_dir / "results"
-    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "retrieval", "real_heldout"}
+    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "retrieval", "real_heldout"}
     for room_type in LEARNED:
         m = json.loads((res / "eval" / room_type / "metrics.json").read_text())
         assert set(m["sets"]) == sets
@@ -562,7 +562,7 @@ def test_a_method_registered_from_outside_runs_through_generation_evaluation_and
     extra.write_text("generation: {methods: [planit, toy, retrieval], plugins: [toy_method]}\n")
     env = {"PYTHONPATH": str(ROOT / "tests")}
     jobs = planned_jobs(snakemake(work, "--dry-run", extra_config=extra, env_extra=env))
-    assert jobs == {"generate", "evaluate", "runtime"}, jobs  # nothing learned again: toy trains nothing
+    assert jobs == {"generate", "evaluate", "gallery_3d", "runtime"}, jobs  # nothing learned again: toy trains nothing
     snakemake(work, extra_config=extra, env_extra=env)
     res = work / "results"
     for room_type in LEARNED:

@@ -20,8 +20,8 @@ STYLE = """
 body { margin: 0; font: 13px sans-serif; }
 #bar { padding: 6px; background: #eee; display: flex; gap: 12px; align-items: center; flex-wrap: wrap; }
 #main { display: flex; height: calc(100vh - 44px); }
-#view { flex: 1; width: 100%; height: 100%; display: block; }
-#side { width: 340px; overflow: auto; padding: 8px; border-left: 1px solid #ccc; }
+#view { flex: 1 1 0; width: 0; min-width: 0; height: 100%; display: block; }
+#side { flex: none; width: 340px; overflow: auto; padding: 8px; border-left: 1px solid #ccc; }
 #side li { margin-bottom: 4px; }
 .key span { display: inline-block; width: 12px; height: 12px; margin: 0 4px 0 10px; vertical-align: middle; }
 """
