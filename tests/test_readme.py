@@ -39,7 +39,7 @@ def test_readme_commands_work_as_written(clone):
         if any(c in cmd for c in CLUSTER_ONLY):
             continue
         out = subprocess.run(shlex.split(cmd), cwd=clone, capture_output=True, text=True, env=_env_without_venv(),
-                             timeout=600)
+                             timeout=1200)  # the AI2-THOR run: every method, its gallery, on 2 cores
         assert out.returncode == 0, f"{cmd}\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}"
         ran += 1
         if cmd == "make pipeline":  # it ends with the report
