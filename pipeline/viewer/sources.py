@@ -12,16 +12,13 @@ from .. import tables
 from ..errors import InputError
 from ..extraction import extract_room
 from ..geometry.raycast import intersector_class
-from ..room import load_rooms, merge_walls, room_inputs
+from ..placement.layout import walls_of
+from ..room import load_rooms, room_inputs
 from . import payload
 
 
 def _shards(results: Path, pattern: str) -> list[Path]:
     return [Path(p) for p in sorted(glob.glob(str(results / pattern)))]
-
-
-def _walls(room):
-    return merge_walls(room.wall_segments, room.wall_ids, room.wall_thickness, room.height)
 
 
 def _final_graph(nodes: Path | None, edges: Path | None, room_id: str) -> tuple[list[dict], dict[str, str]]:
@@ -44,7 +41,7 @@ def corpus_room(shards: dict[str, list[Path]], graphs: tuple[Path, Path] | None,
     room = inputs[room_id]
     meshes, box_models = tables.read_meshes_of(shards["models"], objs["model_id"].dropna())
     edges, roles = _final_graph(*(graphs or (None, None)), room_id)
-    return payload.room_payload(title or f"{room_id} ({room.room_type})", room, _walls(room), meshes.get,
+    return payload.room_payload(title or f"{room_id} ({room.room_type})", room, walls_of(room), meshes.get,
                                 {"final": edges} if edges else {}, roles, box_models)
 
 
@@ -94,6 +91,6 @@ def generated_room(folder: Path, scene: str, planned: tuple[Path, Path] | None, 
         plan = [e for e in payload.edge_rows(edges) if e["edge_type"] in ("support", "spatial")]
         placed = set(room.object_ids) | set(room.wall_ids)
         graphs = {"difference": payload.difference(plan, extracted, placed), "planned": plan, **graphs}
-    walls = _walls(room)
+    walls = walls_of(room)
     return payload.room_payload(f"{sid} ({folder.parent.name}, {folder.name})", room, walls, meshes.get, graphs,
                                 None, box_models)

@@ -108,6 +108,7 @@ class Assembly:
         self.dropped: list[str] = []
         self.drops: list[dict] = []
         self.accepted: dict = {}
+        self._floor_cells: np.ndarray | None = None
 
     def candidate(self, k: int, inst, i: int, ways: list[Placing]) -> tuple[np.ndarray, np.ndarray] | None:
         """Try ``i``'s box and pose for object ``k`` (see the module)."""
@@ -137,9 +138,11 @@ class Assembly:
         return place(inst, box[0], box[1], support, yaw)
 
     def free_cells(self) -> np.ndarray:
-        """``(m, 2)`` centres of the search's candidate cells on the floor."""
-        grid = Grid(self.room.outline, self.mpp)
-        return grid.points[grid.floor]
+        """``(m, 2)`` centres of the search's candidate cells on the floor (rasterised once per scene)."""
+        if self._floor_cells is None:
+            grid = Grid(self.room.outline, self.mpp)
+            self._floor_cells = grid.points[grid.floor]
+        return self._floor_cells
 
     def place_one(self, k: int) -> bool:
         """Place object ``k`` within ``placement.tries``; False when none passes the checks."""
