@@ -197,6 +197,10 @@ def test_breadth_first_order_starts_at_the_walls_and_puts_supports_first():
     lonely = ScenePlan("s", "r", "bedroom", [*plan.ids, "x"], [*plan.categories, "bed"], [*plan.symmetry, "none"],
                        [*plan.tier, 1], [*plan.parent, None], [*plan.role, "none"], plan.edges)
     assert [lonely.ids[k] for k in assemble.bfs_order(lonely, {"wall_0"})][-1] == "x"
+    # support parents in a cycle, or naming no object (a generated graph can hold both), still end the order
+    odd = ScenePlan("s", "r", "bedroom", ["a", "b", "c"], ["bed"] * 3, ["none"] * 3, [1, 1, 1], ["b", "a", "ghost"],
+                    ["none"] * 3, [])
+    assert sorted(assemble.bfs_order(odd, {"wall_0"})) == [0, 1, 2]
 
 
 def test_an_object_no_try_can_place_is_left_out_with_what_it_supports():

@@ -43,7 +43,8 @@ class Placing:
 
 def bfs_order(plan: ScenePlan, roots: set[str]) -> list[int]:
     """Object indices breadth-first from ``roots`` (walls) along the plan's edges, an object only after its support
-    parent; objects no edge reaches are started from in plan order."""
+    parent; objects no edge reaches are started from in plan order (one whose parent is placed first; when support
+    parents form a cycle or name no object, the first left, so the order always ends)."""
     pos = {v: k for k, v in enumerate(plan.ids)}
     nxt: dict[str, list[str]] = {}
     for e in plan.edges:
@@ -52,11 +53,15 @@ def bfs_order(plan: ScenePlan, roots: set[str]) -> list[int]:
     seen = set(roots)
     queue = deque(t for r in sorted(roots) for t in nxt.get(r, []))
     while len(done) < len(plan.ids):
+        forced = None
         if not queue:
-            queue.append(next(v for v in plan.ids if v not in seen))
+            left = [v for v in plan.ids if v not in seen]
+            ready = [v for v in left if plan.parent[pos[v]] is None or plan.parent[pos[v]] in seen]
+            forced = left[0] if not ready else None
+            queue.append(ready[0] if ready else left[0])
         v = queue.popleft()
         k = pos.get(v)
-        if k is None or v in seen or (plan.parent[k] is not None and plan.parent[k] not in seen):
+        if k is None or v in seen or (v != forced and plan.parent[k] is not None and plan.parent[k] not in seen):
             continue
         seen.add(v)
         done.append(k)
