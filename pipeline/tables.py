@@ -233,6 +233,11 @@ SCHEMAS["scenes"] = pa.schema([
     _f("colliding_objects", _I32, doc="objects penetrating another deeper than instantiate.checks.collision"),
     _f("unanchored_objects", _I32, doc="objects the string method's assembly placed with no placed neighbour (on a "
        "random free cell); null for the other methods"),
+    _f("violations", _I32, doc="annealing methods (infinigen, saog): hard violations of the best state before the "
+       "objects in them were left out; null for the other methods"),
+    _f("energy", _F64, doc="annealing methods: the best state's weighted soft energy"),
+    _f("energy_trace", _STR, doc="annealing methods: JSON rows (stage, step, temperature, violations, energy, objects) "
+       "every 10 steps"),
 ])
 SCHEMAS["splits"] = pa.schema([
     _f("room_id", _STR, nullable=False), _f("room_type", _CAT),
@@ -474,6 +479,11 @@ def write_atomic(path: str | Path, write_to) -> Path:
 def write_json(path: str | Path, value) -> Path:
     """A JSON side file (summaries, metrics), written atomically."""
     text = json.dumps(value, indent=2)
+    return _atomic(Path(path), lambda tmp: Path(tmp).write_text(text))
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """A text side file (a program, a grammar), written atomically."""
     return _atomic(Path(path), lambda tmp: Path(tmp).write_text(text))
 
 

@@ -48,6 +48,7 @@ wildcard_constraints:
     room="[A-Za-z0-9_.]+",
     keep="[0-9]+",
     net="|".join(planit_methods.PLACEMENT_LEARNERS),
+    program="|".join(planit_methods.PROGRAM_LEARNERS),
     method="|".join(config["generation"]["methods"]),
     generator="|".join(planit_methods.GRAPH_SOURCES),
     variant="|".join(v for v, s in config["instantiate"]["variants"].items() if s["graphs"] == "heldout"),
@@ -79,6 +80,7 @@ REPORT = "results/graphs/{corpus}/report/{name}"
 METRICS = "results/metrics/{corpus}/{name}.json"
 GRAPH_MODEL = "results/graph_model/{room_type}/{generator}/{name}"  # a graph generator's model and graphs
 PLACEMENT = "results/placement/{room_type}/{net}/{name}"
+PROGRAM = "results/programs/{room_type}/{program}.{name}"  # a readable program (yaml) and its summary (json)
 GENERATED = "results/generated/{room_type}/{method}/{name}"
 ABLATION = "results/generated/{room_type}/{variant}/{name}"  # Table 3's variants (held-out graphs)
 SPEC = "results/specs/{spec}/{name}"  # a partial graph's completions (graphs/) and their rooms
@@ -94,6 +96,7 @@ RUNTIME = "results/runtime.csv"
 RUNTIME_HTML = "results/runtime.html"
 METHODS = config["generation"]["methods"]
 VARIANTS = config["instantiate"]["variants"]
+ANNEALING = [m for m in METHODS if planit_methods.get(m).program is not None]  # methods with an energy trace
 GENERATORS = planit_methods.graph_sources_of(METHODS)  # the graph generators the methods place graphs of
 TABLE3_VARIANTS = [v for v, spec in VARIANTS.items() if spec["graphs"] == "heldout"]
 # the placement learners trained: PlanIT's CFCN (Table 3 places with it) and those the methods read
@@ -125,6 +128,11 @@ def generator_sample_keys(wildcards):
 def placement_train_keys(wildcards):
     """Params function: the keys a placement learner's training reads."""
     return keys(*planit_methods.placement_learner(wildcards.net).train_keys(config))
+
+
+def program_train_keys(wildcards):
+    """Params function: the keys a program learner reads."""
+    return keys(*planit_methods.program_learner(wildcards.program).train_keys(config))
 
 
 def method_keys(wildcards):
@@ -225,6 +233,8 @@ def get_method_inputs(wildcards):
                 for t in ("nodes", "edges")}
     if m.model is not None:
         out["model"] = PLACEMENT.format(room_type=wildcards.room_type, net=m.model, name="model.pt")
+    if m.program is not None:
+        out["program"] = PROGRAM.format(room_type=wildcards.room_type, program=m.program, name="yaml")
     if m.reference is not None:
         out |= {f"reference_{t}": GENERATED.format(room_type=wildcards.room_type, method=m.reference, name=f"{t}.parquet")
                 for t in ("rooms", "architecture", "objects", "scenes")}
@@ -271,4 +281,5 @@ def learned_outputs(wildcards):
         *expand(GENERATED, room_type=types, method=METHODS, name="summary.json"),
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
         *expand(EVAL, room_type=types, name=["metrics.json", "gallery3d.html"]),
+        *expand(EVAL, room_type=types, name=["energy_trace.png"] if ANNEALING else []),
     ]

@@ -76,6 +76,27 @@ rule gallery_3d:
         STAGE
 
 
+rule energy_trace:
+    input:
+        generated_scenes=expand(GENERATED, method=ANNEALING, name="scenes.parquet", allow_missing=True),
+        summaries=expand(GENERATED, method=ANNEALING, name="summary.json", allow_missing=True),
+    output:
+        figure=report(EVAL.replace("{name}", "energy_trace.png"), caption="../report/energy_trace.rst",
+                      category="5. Evaluation", subcategory="{room_type}",
+                      labels={"room type": "{room_type}", "figure": "energy trace"}),
+    params:
+        config=keys("seed"),
+        io=stage_io("energy_trace"),
+    log:
+        "logs/energy_trace/{room_type}.log",
+    benchmark:
+        "benchmarks/energy_trace/{room_type}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
+
+
 rule runtime:
     input:
         corpus=CORPUS_OUTPUTS,

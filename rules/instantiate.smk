@@ -34,6 +34,31 @@ rule train_placement:
         STAGE
 
 
+rule learn_program:
+    input:
+        rooms=shards_of(FILTER_ROOMS),
+        architecture=shards_of(INGEST, table="architecture"),
+        objects=shards_of(INGEST, table="objects"),
+        nodes=GATHERED.format(corpus="ingested", table="nodes"),
+        edges=GATHERED.format(corpus="ingested", table="edges"),
+        split=SPLIT,
+    output:
+        program=report(PROGRAM.replace("{name}", "yaml"), caption="../report/program.rst", category="3. Training",
+                       subcategory="programs", labels={"room type": "{room_type}", "program": "{program}"}),
+        summary=PROGRAM.replace("{name}", "json"),
+    params:
+        config=program_train_keys,
+        io=stage_io("learn_program"),
+    log:
+        "logs/learn_program/{room_type}-{program}.log",
+    benchmark:
+        "benchmarks/learn_program/{room_type}-{program}.tsv"
+    conda:
+        ENV
+    shell:
+        STAGE
+
+
 rule generate:
     input:
         unpack(get_method_inputs),

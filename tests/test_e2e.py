@@ -264,7 +264,8 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
     from pipeline.corpus.procedural_rules import RULES
 
     res = run_dir / "results"
-    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "retrieval", "real_heldout"}
+    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "infinigen", "saog",
+            "retrieval", "real_heldout"}
     for room_type in LEARNED:
         m = json.loads((res / "eval" / room_type / "metrics.json").read_text())
         assert set(m["sets"]) == sets
@@ -290,6 +291,60 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
         assert tables.metadata(res / "eval" / room_type / "scenes.parquet")["pipeline.schema"] == "eval_scenes/v1"
         assert rows.groupby("set").size().to_dict() == {k: v["scenes"] for k, v in m["sets"].items() if v["scenes"]}
         assert rows.walkable_share.between(0, 1).all() and rows.nn_similarity.between(0, 1).all()
+
+
+def test_the_annealing_methods_learn_readable_programs_and_their_rooms_are_scored(run_dir):
+    """infinigen and saog: a program per learned room type (derived from the training split, parsed back), rooms with
+    a record of their annealing (no hard violation left in a placed scene), a row in the evaluation with the time per
+    scene, and the energy trace figure."""
+    from pipeline.methods.infinigen.program import load_program
+    from pipeline.methods.saog.layout import load_grammar
+
+    res = run_dir / "results"
+    for room_type in LEARNED:
+        program = load_program(res / "programs" / room_type / "infinigen.yaml")
+        split = pd.read_parquet(res / "splits" / f"{room_type}.parquet")
+        train = set(split.loc[split["split"].isin(["fit", "validation"]), "room_id"])
+        objs = pd.concat([pd.read_parquet(p) for p in sorted((res / "ingest" / "shards").glob("objects-*.parquet"))])
+        assert program.room_type == room_type and set(program.objects) <= set(objs[objs["room_id"].isin(train)]["category"])
+        grammar = load_grammar(res / "programs" / room_type / "saog.yaml", room_type)
+        assert all(w >= 0 for w in grammar["weights"].values()) and grammar["categories"]
+        for method in ("infinigen", "saog"):
+            scenes = pd.read_parquet(res / "generated" / room_type / method / "scenes.parquet")
+            assert len(scenes) == 2 and scenes["energy"].notna().all() and scenes["energy_trace"].notna().all()
+            assert (scenes["seconds"] > 0).all()
+            m = json.loads((res / "eval" / room_type / "metrics.json").read_text())["sets"][method]
+            assert m["attempted"] == 2 and (m["scenes"] == 0 or m["seconds_per_scene"] > 0)
+        assert (res / "eval" / room_type / "energy_trace.png").stat().st_size > 10_000
+
+
+def test_a_users_own_program_runs_with_planit_generate(run_dir, tmp_path):
+    """``planit generate --method infinigen --program FILE``: an edited program (no bed, two to three wardrobes, ...)
+    is what the rooms hold; a program with an error is refused in one line naming its file and line."""
+    res = run_dir / "results"
+    text = (res / "programs/bedroom/infinigen.yaml").read_text()
+    lines = [ln for ln in text.splitlines() if not ln.strip().startswith(("bed:", "#")) and "next_to: bed" not in ln
+             and "facing: bed" not in ln and "on: bed" not in ln]
+    mine = tmp_path / "mine.yaml"
+    mine.write_text("\n".join(lines) + "\n")
+    shards = lambda t: [a for p in sorted((res / ("filter" if t == "rooms" else "ingest") / "shards").glob(f"{t}-*.parquet"))
+                        for a in (f"--{t}", str(p))]
+    out = {t: tmp_path / f"{t}.parquet" for t in ("rooms", "architecture", "objects", "models", "scenes")}
+    cmd = [sys.executable, "-m", "pipeline", "generate", *shards("rooms"), *shards("architecture"), *shards("objects"),
+           *shards("models"), "--split", str(res / "splits/bedroom.parquet"),
+           "--symmetry", str(res / "graphs/ingested/symmetry.parquet"),
+           "--category-sizes", str(res / "graphs/ingested/stats/category_sizes.parquet"), "--program", str(mine),
+           *[a for t, p in out.items() for a in (f"--out-{t}", str(p))], "--out-summary", str(tmp_path / "s.json"),
+           "--out-archive", str(tmp_path / "s.zip"), "--room-type", "bedroom", "--method", "infinigen", "--count", "2",
+           "--config", str(ROOT / "config" / "tiny.yaml")]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    got = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True, env=env)
+    assert got.returncode == 0, got.stderr[-2000:]
+    objs = pd.read_parquet(out["objects"])
+    assert len(objs) and "bed" not in set(objs["category"])
+    mine.write_text("room_type: bedroom\nobjects:\n  bed: {count: [2, 1], stage: large}\n")
+    bad = subprocess.run(cmd, cwd=run_dir, capture_output=True, text=True, env=env)
+    assert bad.returncode != 0 and f"{mine}:3: objects.bed.count" in bad.stderr and "Traceback" not in bad.stderr
 
 
 def test_the_run_time_table_holds_every_benchmarked_job(run_dir):

@@ -16,7 +16,8 @@ FIGURES = {"scenes": "rooms scored (placed)", "attempted": "rooms the method att
            "floor object can be reached", "functional_all": "share of rooms passing every functional check",
            "contents_excess": "share of rooms with a category more often than any training room",
            "contents_missing": "share of rooms missing a category the training rooms hold",
-           "consistency": "planned edges found again", "nn_similarity": "similarity to the nearest training room"}
+           "consistency": "planned edges found again", "nn_similarity": "similarity to the nearest training room",
+           "seconds_per_scene": "median seconds per scored room (one core)"}
 
 
 def _with_interval(value, span) -> str | int | None:

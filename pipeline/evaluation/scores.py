@@ -57,8 +57,10 @@ def rule_satisfaction(rs: RoomSet, checker) -> dict:
 
 def set_counts(rows: pd.DataFrame, rs: RoomSet) -> dict:
     """How many rooms a set scores, how many its method attempted and how many of them are partial."""
+    seconds = None if rs.scenes is None or rs.scenes["seconds"].isna().all() else float(rs.scenes["seconds"].median())
     return {"scenes": len(rows), "attempted": rs.attempted,
-            "partial": 0 if rs.scenes is None else int((rs.scenes["status"].astype(str) == "partial").sum())}
+            "partial": 0 if rs.scenes is None else int((rs.scenes["status"].astype(str) == "partial").sum()),
+            "seconds_per_scene": seconds}
 
 
 def floors(train: RoomSet, real: RoomSet, generated: int, cfg: dict, seed: int) -> dict:
@@ -130,7 +132,7 @@ def label_maps(rs: RoomSet, index: dict, cfg: dict) -> np.ndarray:
 
 TABLE_COLUMNS = ["scenes", "attempted", "category_kl", "count_distance", "object_collision_rate", "scene_collision_rate",
                  "out_of_bounds_rate", "walkable_share", "reachable_scenes", "consistency", "violation", "nn_similarity",
-                 "contents_excess", "contents_missing", "functional_all"]
+                 "contents_excess", "contents_missing", "functional_all", "seconds_per_scene"]
 
 
 def metrics_table(metrics: dict) -> pd.DataFrame:

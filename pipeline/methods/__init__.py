@@ -7,11 +7,12 @@ import importlib
 from types import SimpleNamespace
 
 from ..errors import InputError
-from .interface import Corpus, Generated, GraphGenerator, GraphSource, LayoutGenerator, Method, PlacementLearner, Scene, Task
+from .interface import (Corpus, Generated, GraphGenerator, GraphSource, LayoutGenerator, Method, PlacementLearner,
+                        ProgramLearner, Scene, Task)
 
 __all__ = ["Corpus", "Generated", "GraphGenerator", "GraphSource", "LayoutGenerator", "Method", "Scene", "Task", "register",
            "get", "names", "load_plugins", "layout_of", "graph_generator", "graph_source", "graph_sources_of", "PlacementLearner", "placement_learner", "placement_fit",
-           "placement_nets_of"]
+           "placement_nets_of", "ProgramLearner", "program_learner", "program_fit"]
 
 _METHODS: dict[str, Method] = {}
 
@@ -88,7 +89,18 @@ def placement_nets_of(method_names: list[str]) -> list[str]:
     return list(dict.fromkeys(get(m).model for m in method_names if get(m).model is not None))
 
 
-from .builtin import BUILTIN, GRAPH_SOURCES, PLACEMENT_LEARNERS  # noqa: E402
+def program_learner(name: str) -> ProgramLearner:
+    if name not in PROGRAM_LEARNERS:
+        raise InputError(f"no program learner '{name}' (known: {', '.join(sorted(PROGRAM_LEARNERS))})")
+    return PROGRAM_LEARNERS[name]
+
+
+def program_fit(name: str):
+    """The program learner's ``fit`` function, imported."""
+    return _load(program_learner(name).fit)
+
+
+from .builtin import BUILTIN, GRAPH_SOURCES, PLACEMENT_LEARNERS, PROGRAM_LEARNERS  # noqa: E402
 
 for _m in BUILTIN:
     register(_m)

@@ -2,7 +2,7 @@
 (instantiate.variants of sampled graphs), the string VAE's graphs placed by PlanIT's search, and retrieval."""
 from __future__ import annotations
 
-from .interface import GraphSource, Method, PlacementLearner
+from .interface import GraphSource, Method, PlacementLearner, ProgramLearner
 
 
 def _preset_keys(section: str, *more: str):
@@ -30,6 +30,21 @@ PLACEMENT_LEARNERS = {p.name: p for p in [
                                      f"strings.tagger.presets.{config['strings']['tagger']['preset']}",
                                      "strings.tagger.device", "strings.tagger.bandwidth"]),
 ]}
+
+
+PROGRAM_LEARNERS = {p.name: p for p in [
+    ProgramLearner("infinigen", "pipeline.methods.infinigen.derive:fit_program",
+                   lambda config: ["seed", "infinigen.derive"]),
+    ProgramLearner("saog", "pipeline.methods.saog.learn:fit_grammar",
+                   lambda config: ["seed", "saog", "instantiate.checks"]),
+]}
+
+
+def _solver_keys(section: str):
+    """The keys an annealing method reads: its section, the placement checks' thresholds it takes as hard limits,
+    the context it shares with PlanIT's search (model pool, learned support shares) and the walkability measure."""
+    return lambda config, name: ["seed", section, "extract", "floor_contact", "instantiate",
+                                 "evaluate.collision.penetration", "evaluate.walk"]
 
 
 def search_keys(config: dict, name: str) -> list[str]:
@@ -61,6 +76,14 @@ BUILTIN = [
                                       "strings.tagger.placement", "strings.tagger.preset"],
            description="the string VAE's sampled graphs placed the paper's way: each edge tagged with a relative-pose "
            "cluster by the edge tagger, assembled breadth-first from the walls with repair"),
+    Method("infinigen", "pipeline.methods.infinigen.layout:InfinigenLayout", program="infinigen",
+           keys=_solver_keys("infinigen"), scenes=lambda config, name: config["infinigen"]["scenes"],
+           description="an Infinigen-Indoors-style constraint program per room type, derived from the training split, "
+           "solved by staged simulated annealing (large, medium, small objects)"),
+    Method("saog", "pipeline.methods.saog.layout:SaogLayout", program="saog",
+           keys=_solver_keys("saog"), scenes=lambda config, name: config["saog"]["scenes"],
+           description="Qi et al.'s S-AOG: a stochastic grammar learned from the training split (counts, sizes, wall "
+           "distance and angle, groups, affordances; weights by contrastive divergence), sampled by MCMC over poses"),
     Method("retrieval", "pipeline.methods.retrieval:Retrieval", reference="planit",
            keys=lambda config, name: ["evaluate.render"],
            description="each of PlanIT's rooms replaced by its nearest training room (the memorisation floor)"),

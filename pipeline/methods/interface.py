@@ -70,6 +70,7 @@ class Task:
     reference: Generated | None = None
     count: int | None = None
     threads: int = 1  # CPU threads for the method's networks (the rule's threads)
+    program: Path | None = None  # the method's program: a constraint program or a grammar (YAML), see ProgramLearner
 
 
 @dataclass
@@ -136,6 +137,18 @@ class PlacementLearner:
 
 
 @dataclass(frozen=True)
+class ProgramLearner:
+    """A registered learner of a readable program (rule ``learn_program``, its ``program`` wildcard): Infinigen's
+    constraint program or S-AOG's grammar, written as YAML a user can read, edit and pass back (``planit generate
+    --program FILE``). ``fit`` (``"module:function"``) is ``fit(config, room_type, node_df, edge_df, inputs, split)``
+    over one room type's final graph rows and rooms, returning the program's text and a summary (dict);
+    ``train_keys(config)``: the dotted config keys it reads."""
+    name: str
+    fit: str
+    train_keys: Callable[[dict], list[str]]
+
+
+@dataclass(frozen=True)
 class Method:
     """A named generator: a layout generator (``layout``: ``"module:factory"``, imported when the method runs;
     ``factory(config, name)`` returns the :class:`LayoutGenerator`) and the inputs its rule gives it."""
@@ -144,6 +157,7 @@ class Method:
     graphs: str | None = None  # the graph generator whose sampled graphs it places ("planit", "strings"), or None
     model: str | None = None  # the placement learner whose checkpoint it reads ("cfcn" | "fcn" | "tagger"), or None
     reference: str | None = None  # the method whose rooms it reads, or None
+    program: str | None = None  # the program learner whose YAML it reads ("infinigen" | "saog"), or None
     keys: Callable[[dict, str], list[str]] = lambda config, name: ["seed"]  # the config keys it reads
     scenes: Callable[[dict, str], int] | None = None  # scenes it generates by default (None: one per held-out room)
     description: str = ""

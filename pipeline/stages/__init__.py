@@ -84,11 +84,18 @@ _ALL = [
           "networks, or the string method's edge tagger (resumes from the checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT), outputs=TRAINING,
           params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned), fcn (the unconditional ablation) or tagger (the string method's edge tagger)")),
           threads=True),
+    Stage("learn_program", "Learn one room type's readable program from its training rooms: Infinigen's constraint "
+          "program (derived from the final graphs' statistics) or S-AOG's grammar (with its weights).",
+          inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT),
+          outputs=(one("program", "the program (YAML, readable and editable)"), one("summary", "what it was learned "
+                       "from and the statistics behind each choice (JSON)")),
+          params=(ROOM_TYPE, Param("program", help="a registered program learner (infinigen, saog)"))),
     Stage("generate", "Generate rooms of one room type with one method: canonical tables, a record per scene, "
           "GLB / PNG / JSON per scene.",
           inputs=(*CORPUS_SHARDS, SPLIT, one("symmetry"), one("category_sizes"),
                   one("nodes", "the method's graphs (its graph generator's sampled nodes)", True),
                   one("edges", optional=True), one("model", "the placement networks the method reads", True),
+                  one("program", "the method's constraint program or grammar (YAML; results/programs/<type>/)", True),
                   *(one(f"reference_{t}", "the rooms of the method's reference method", True)
                     for t in ("rooms", "architecture", "objects", "scenes"))),
           outputs=GENERATED, params=(ROOM_TYPE, METHOD, Param("count", int, None, "scenes (default: the method's)")),
@@ -130,6 +137,9 @@ _ALL = [
                   many("generated_models"), many("sampled_nodes", "the graph generators' sampled graphs", optional=True),
                   many("sampled_edges", optional=True), *CORPUS_SHARDS, *GRAPHS, SPLIT),
           outputs=(one("page", "the viewer page (HTML, three.js inlined)"),), params=(ROOM_TYPE,)),
+    Stage("energy_trace", "The annealing methods' energy traces (the first scene of each method) of one room type.",
+          inputs=(many("generated_scenes", "one per annealing method"), many("summaries", "the same methods' summaries")),
+          outputs=(one("figure", "energy and hard violations over the steps (PNG)"),), params=(ROOM_TYPE,)),
     Stage("runtime", "Job seconds and peak memory per rule from the benchmark files, and the run's wall-clock span.",
           inputs=(many("corpus", "the corpus stages' outputs (their jobs are timed; read for their presence)"),
                   many("learned", "the learned room types' outputs (likewise)")),

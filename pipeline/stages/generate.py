@@ -18,5 +18,5 @@ def run(config: dict, inp: Files, out: Files, room_type: str, method: str, count
     reference = inp.reference_rooms and load_generated(inp.reference_rooms, inp.reference_architecture,
                                                        inp.reference_objects, inp.reference_scenes)
     graphs = (inp.nodes, inp.edges) if inp.nodes else None
-    task = methods.Task(config, method, corpus, graphs, inp.model, reference, count, threads)
+    task = methods.Task(config, method, corpus, graphs, inp.model, reference, count, threads, inp.program)
     return generate_rooms(methods.layout_of(spec, config), method, task, out)

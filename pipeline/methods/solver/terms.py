@@ -1,0 +1,118 @@
+"""Energy terms over a solver state. Hard constraints are counted as violations (a move that adds one is rejected):
+collisions (the box penetration depth of ``geometry.boxes``, the first test of PlanIT's placement check),
+footprints outside the floor (``geometry.polygon.outside_area``, the check's and the evaluation's test), door
+clearances (``placement.checks.blocks_door``'s zones) and overhangs (``placement.checks.support_share``). Soft terms
+are weighted scores (:class:`Term`); those of Infinigen's operators live in ``operators``."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import shapely
+
+from ...geometry import boxes as gb
+from ...geometry.polygon import door_zones, outside_area
+from ...placement.checks import AREA_EPS, support_share
+from .state import State
+
+HARD = ("collision", "outside", "door", "overhang")
+
+
+@dataclass(frozen=True)
+class Term:
+    """A weighted soft term: ``fn(state)`` is a non-negative score."""
+    name: str
+    weight: float
+    fn: Callable[[State], float]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The hard constraints' thresholds (from ``instantiate.checks``: the same margins PlanIT's search uses)."""
+    collision: float  # m of penetration allowed
+    outside: float  # m the footprint is eroded by before the outside test
+    door: float  # m: depth of the clearance zone inside each door
+    min_support: float  # share of a supported footprint that must rest on its parent
+
+
+def footprints(b: np.ndarray) -> np.ndarray:
+    """``(n, 4, 2)`` footprint corners of ``(n, 7)`` boxes."""
+    return gb.footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
+
+
+def related_mask(state: State) -> np.ndarray:
+    """``(n, n)`` True for support parent-child pairs (their contact is no collision)."""
+    n = len(state.items)
+    rel = np.eye(n, dtype=bool)
+    for k, it in enumerate(state.items):
+        if it.parent >= 0:
+            rel[k, it.parent] = rel[it.parent, k] = True
+    return rel
+
+
+def colliding_pairs(state: State, limit: float) -> int:
+    depth = gb.penetration_depths(state.boxes)
+    return int(np.triu((depth > limit) & ~related_mask(state), 1).sum())
+
+
+class Hard:
+    """Counts a state's hard violations; the room's door zones are built once."""
+
+    def __init__(self, state: State, limits: Limits):
+        self.limits = limits
+        doors = [o for o in state.room.openings if o["kind"] == "door"]
+        quads = door_zones(state.room.outline, np.array([[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in doors]),
+                           limits.door) if doors and limits.door > 0 else np.zeros((0, 4, 2))
+        self.zones = shapely.union_all(shapely.polygons(quads)) if len(quads) else None
+
+    def total(self, state: State) -> int:
+        return sum(self.counts(state).values())
+
+    def counts(self, state: State) -> dict[str, int]:
+        """Violations per hard constraint."""
+        if not state.items:
+            return dict.fromkeys(HARD, 0)
+        grounded = np.array([it.parent < 0 for it in state.items])
+        corners = footprints(state.boxes[grounded])
+        outside = outside_area(state.room.outline, corners, self.limits.outside) > AREA_EPS if len(corners) else []
+        door = 0
+        if self.zones is not None and len(corners):
+            door = int((shapely.area(shapely.intersection(shapely.polygons(corners), self.zones)) > AREA_EPS).sum())
+        overhang = sum(support_share(state.boxes[k], state.boxes[it.parent]) < self.limits.min_support
+                       for k, it in enumerate(state.items) if it.parent >= 0)
+        return {"collision": colliding_pairs(state, self.limits.collision), "outside": int(np.sum(outside)),
+                "door": door, "overhang": int(overhang)}
+
+
+class Energy:
+    """A state's violation count and weighted energy, with each part for the trace."""
+
+    def __init__(self, hard: Hard, terms: list[Term]):
+        self.hard, self.terms = hard, [t for t in terms if t.weight > 0]
+
+    def __call__(self, state: State) -> tuple[int, float, dict]:
+        counts = self.hard.counts(state)
+        parts = {t.name: t.weight * t.fn(state) for t in self.terms}
+        return sum(counts.values()), float(sum(parts.values())), {**counts, **parts}
+
+
+def gaps(state: State, i: int, js: list[int]) -> np.ndarray:
+    """``(len(js),)`` m between item ``i``'s footprint and each of ``js``' (0 where they touch or overlap)."""
+    polys = shapely.polygons(footprints(state.boxes[[i, *js]]))
+    return shapely.distance(polys[0], polys[1:])
+
+
+def front_of(box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The front face's midpoint ``(2,)`` and outward normal ``(2,)`` of a box ``(7,)``."""
+    normal = gb.rotation(box[6]) @ np.array([0.0, 1.0])
+    return box[:2] + normal * box[4], normal
+
+
+def nearest_wall(state: State, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For points ``(n, 2)``: the distance (m) to the nearest wall's inner face and that wall's index."""
+    w = state.walls
+    d = w.b - w.a
+    t = np.clip(np.einsum("nwj,wj->nw", xy[:, None] - w.a[None], d) / np.einsum("wj,wj->w", d, d), 0, 1)
+    dist = np.linalg.norm(xy[:, None] - (w.a[None] + t[..., None] * d[None]), axis=-1)
+    return dist.min(1), dist.argmin(1)

@@ -1,0 +1,158 @@
+"""The annealing engine (pipeline/methods/solver/) on cases with known answers: Infinigen's operators in closed
+form, Metropolis-Hastings at a fixed temperature against the Boltzmann variance, hard constraints that never get
+worse, and a 4 x 3 m bedroom whose optimum is known (nightstands flush beside the bed)."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline.methods.infinigen.energy import specs_of, terms_of
+from pipeline.methods.infinigen.program import parse_program
+from pipeline.methods.solver import operators as op
+from pipeline.methods.solver.anneal import Chain, accept, anneal, solve
+from pipeline.methods.solver.moves import Proposer, Spec, Steps
+from pipeline.methods.solver.schedule import move_weights, temperature
+from pipeline.methods.solver.state import Item, empty_state
+from pipeline.methods.solver.terms import Energy, Hard, Limits, Term
+from pipeline.placement.layout import walls_of
+from pipeline.placement.retrieval import ModelPool
+from pipeline.room import RoomInput
+
+LIMITS = Limits(collision=0.01, outside=0.02, door=0.0, min_support=0.9)
+WALK = {"cell": 0.1, "robot_radius": 0.15, "clearance": 1.0, "door_reach": 0.3, "front_reach": 0.3}
+
+
+def room(w: float, d: float) -> RoomInput:
+    outline = np.array([[0, 0], [w, 0], [w, d], [0, d]], float)
+    segs = np.stack([outline, np.roll(outline, -1, 0)], 1)
+    return RoomInput("r", "bedroom", 2.6, outline, [f"wall_{k}" for k in range(4)], segs, np.full(4, 0.1), [],
+                     [], [], [], np.zeros((0, 7)), np.zeros((0, 7)))
+
+
+def pool(sizes: dict[str, tuple[float, float, float]]) -> ModelPool:
+    """One training instance per category, half extents ``sizes``, standing on the floor at the origin."""
+    rows = [{"category": c, "model_id": f"m_{c}", "cx": 0.0, "cy": 0.0, "cz": h[2], "hx": h[0], "hy": h[1],
+             "hz": h[2], "yaw": 0.0, "px": 0.0, "py": 0.0, "pz": 0.0, "sx": 1.0, "sy": 1.0, "sz": 1.0}
+            for c, h in sizes.items()]
+    return ModelPool(pd.DataFrame(rows), {})
+
+
+def test_infinigen_operators_have_their_closed_forms():
+    assert op.alignment_cost([np.pi / 2], [0.0]) == pytest.approx(0.5)
+    assert op.alignment_cost([np.pi / 2], [0.0], period=np.pi / 2) == pytest.approx(0.0, abs=1e-12)
+    corners = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]], float)
+    facing_centre = np.arctan2(corners[:, 0], -corners[:, 1])  # each front (local +y) points at the origin
+    assert op.rotational_asymmetry(corners, facing_centre, np.zeros(2)) == pytest.approx(0.0, abs=1e-9)
+    moved = corners + [[0.3, 0], [0, 0], [0, 0], [0, 0]]
+    assert op.rotational_asymmetry(moved, facing_centre, np.zeros(2)) > 0.05
+    pair = np.array([[-1.2, 0.2], [1.2, 0.2]])  # two nightstands either side of a bed on the y axis, facing +y
+    assert op.reflection_asymmetry(pair, np.zeros(2), np.zeros(2), np.array([0.0, 1.0])) == pytest.approx(0, abs=1e-9)
+    assert op.reflection_asymmetry(pair + [[0, 0.4], [0, 0]], np.zeros(2), np.zeros(2), [0.0, 1.0]) > 0.1
+    for d, g in [(0.5, 0.8), (2.0, 1.3)]:  # a blocker of diagonal g straight ahead at distance d costs g / d
+        cost = op.accessibility_cost(np.zeros(2), np.array([0.0, 1.0]), np.array([[0.0, d]]), np.array([g]), 3.0)
+        assert cost == pytest.approx(g / d)
+    assert op.accessibility_cost(np.zeros(2), np.array([0.0, 1.0]), np.array([[0.0, -1.0]]), np.ones(1), 3.0) == 0
+
+
+def test_schedules_follow_their_formulas():
+    exp = {"kind": "exponential", "t0": 3.0, "tf": 0.001, "finetune": 0.15}
+    assert temperature(exp, 0, 100) == pytest.approx(3.0)
+    assert temperature(exp, 85, 100) == pytest.approx(0.001) and temperature(exp, 99, 100) == pytest.approx(0.001)
+    assert temperature({"kind": "logarithmic", "t0": 10.0}, 0, 100) == pytest.approx(10 / np.log(2))
+    assert temperature({"kind": "stepwise", "t0": 10.0, "factor": 0.9, "every": 100}, 250, 1000) == pytest.approx(8.1)
+    w = move_weights({"add": 6.0, "translate": 1.0}, {"add": 0.1, "translate": 1.0}, 99, 100)
+    assert w == pytest.approx({"add": 0.1, "translate": 1.0})
+
+
+def test_acceptance_never_trades_a_hard_violation_for_energy():
+    rng = np.random.default_rng(0)
+    assert not any(accept((0, 100.0), (1, 0.0), 1e6, rng) for _ in range(100))
+    assert all(accept((2, 0.0), (1, 1e6), 1e-6, rng) for _ in range(100))
+    assert accept((0, 1.0), (0, 0.5), 1e-9, rng)
+
+
+def test_a_fixed_temperature_chain_samples_the_boltzmann_variance():
+    """One small object free on a 60 x 60 m floor, energy x^2 / 2 about the room's centre: at temperature T the chain's
+    x has variance T (within 5 %)."""
+    r = room(60.0, 60.0)
+    state = empty_state(r, walls_of(r))
+    p = pool({"box": (0.05, 0.05, 0.05)})
+    spec = {"box": Spec("box", (1, 1), "large", "floor")}
+    state = state.with_items([Item("b", "box", p.pick("box", "none", np.random.default_rng(0)), "floor", "large",
+                                   (30.0, 30.0))])
+    energy = Energy(Hard(state, LIMITS), [Term("quadratic", 1.0, lambda s: 0.5 * (s.boxes[0, 0] - 30.0) ** 2)])
+    cfg = {"schedule": {"kind": "constant", "t0": 0.5}, "moves": {"start": {"translate": 1.0}, "end": {}}}
+    v, e, _ = energy(state)
+    chain = anneal(Chain(state, (v, e), state, (v, e)), energy, Proposer(spec, p, Steps(2.0, 0.01, 1.0, 0.0)),
+                   {"box"}, 30000, cfg, np.random.default_rng(1), record_every=1)
+    x = np.array([30.0 + np.sqrt(2 * row["energy"]) for row in chain.trace[2000:]])  # |x - 30|: the variance of x
+    assert np.mean((x - 30.0) ** 2) == pytest.approx(0.5, rel=0.05)
+
+
+BEDROOM = """
+room_type: bedroom
+objects:
+  bed: {count: [1, 1], stage: large, against_wall: true}
+  nightstand: {count: [2, 2], stage: medium, against_wall: true, next_to: bed}
+weights: {next_to: 2.0, symmetry: 1.0, accessibility: 0.2, alignment: 0.5, free_floor: 0.0, facing: 1.0}
+"""
+SIZES = {"bed": (0.8, 1.0, 0.3), "nightstand": (0.25, 0.2, 0.3)}
+
+
+def solve_program(text: str, r: RoomInput, sizes: dict, seed: int, steps: dict | None = None, given=None):
+    """Solve a program in room ``r`` (``given``: items already placed, their stage not solved again)."""
+    program = parse_program(text, "test.yaml")
+    p = pool(sizes)
+    specs = specs_of(program, p)
+    state = empty_state(r, walls_of(r))
+    if given is not None:
+        state = state.with_items(given(p))
+    hard = Hard(state, LIMITS)
+    cfg = {"schedule": {"kind": "exponential", "t0": 3.0, "tf": 0.001, "finetune": 0.15},
+           "moves": {"start": {"translate": 1.0, "rotate": 0.5, "replane": 2.0, "swap": 1.0, "add": 6.0, "delete": 2.0,
+                               "resample": 1.0, "reinit": 1.0},
+                     "end": {"replane": 0.1, "swap": 0.1, "add": 0.1, "delete": 0.0, "resample": 0.1, "reinit": 0.5}},
+           "steps": steps or {"large": 100, "medium": 300, "small": 100}}
+    energy = Energy(hard, terms_of(program, 1.0, WALK))
+    stages = ("medium", "small") if given is not None else ("large", "medium", "small")
+    proposer = Proposer(specs, p, Steps(8.0, 0.01, 1.0, np.pi / 4), violations=hard.total, attempts=20)
+    chain = solve(state, specs, energy, proposer, cfg,
+                  np.random.default_rng(seed), stages)
+    return chain, hard
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_nightstands_end_flush_beside_the_bed(seed):
+    """The bed stands against the 3 m wall's middle; the solver places two nightstands, flush against it on either
+    side in every seed (within 2 cm), mirrored about its centre line."""
+    bed = lambda p: [Item("bed", "bed", p.pick("bed", "none", np.random.default_rng(0)), "wall", "large", (1.5, 0.0),
+                          wall=1)]
+    chain, _ = solve_program(BEDROOM, room(4.0, 3.0), SIZES, seed, given=bed)
+    s = chain.best
+    assert chain.best_score[0] == 0
+    bed = next(k for k, it in enumerate(s.items) if it.category == "bed")
+    stands = [k for k, it in enumerate(s.items) if it.category == "nightstand"]
+    assert len(stands) == 2
+    for k in stands:  # same wall as the bed, touching one of its sides
+        assert s.items[k].wall == s.items[bed].wall
+        assert abs(abs(s.items[k].u[0] - s.items[bed].u[0]) - (0.8 + 0.25)) < 0.02
+    assert np.sign(s.items[stands[0]].u[0] - s.items[bed].u[0]) != np.sign(s.items[stands[1]].u[0] - s.items[bed].u[0])
+    rows = [r for r in chain.trace]
+    assert all(b["violations"] <= a["violations"] for a, b in zip(rows, rows[1:]) if a["stage"] == b["stage"])
+
+
+DINING = """
+room_type: dining
+objects:
+  table: {count: [1, 1], stage: large}
+  chair: {count: [2, 6], stage: medium, facing: table}
+"""
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_count_ranges_hold_in_every_seed(seed):
+    chain, hard = solve_program(DINING, room(5.0, 4.0), {"table": (0.6, 0.45, 0.38), "chair": (0.22, 0.22, 0.45)},
+                                seed, {"large": 60, "medium": 300, "small": 0})
+    n = chain.best.count("chair")
+    assert 2 <= n <= 6 and chain.best.count("table") == 1 and chain.best_score[0] == 0
