@@ -20,6 +20,21 @@ def room_graphs(nodes: Path, edges: Path, room_type: str) -> tuple[data.Vocab, l
     return vocab, data.graphs_from_tables(node_df, edge_df, vocab)
 
 
+def graphs_and_rooms(nodes: Path, edges: Path, rooms: list[Path], architecture: list[Path], objects: list[Path],
+                     room_type: str):
+    """The room type's final graph rows (nodes, edges frames) and its graphed rooms (room id -> RoomInput): what
+    every learner of a room type's rooms reads."""
+    from ..room import load_rooms
+
+    flt = [("room_type", "=", room_type)]
+    node_df = tables.read(nodes, "final_nodes", filters=flt).to_pandas()
+    if node_df.empty:
+        raise InputError(f"{nodes}: no graph of room type '{room_type}'")
+    edge_df = tables.read(edges, "final_edges", filters=flt).to_pandas()
+    _, _, _, inputs = load_rooms(rooms, architecture, objects, set(node_df["room_id"]))
+    return node_df, edge_df, inputs
+
+
 def read_split(path: Path) -> dict[str, str]:
     """Room id -> fit | validation | heldout, from a room type's split table."""
     rows = tables.read(path, "splits", columns=["room_id", "split"]).to_pylist()

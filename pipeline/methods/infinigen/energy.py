@@ -35,33 +35,32 @@ def _of(state: State, category: str) -> list[int]:
     return [k for k, it in enumerate(state.items) if it.category == category]
 
 
+def related(program: Program, state: State, relation: str):
+    """``(k, js)`` for each object whose rule names a category in ``relation`` (next_to, facing): its index and the
+    indices of the objects of that category."""
+    for k, it in enumerate(state.items):
+        rule = program.objects.get(it.category)
+        target = getattr(rule, relation) if rule is not None else None
+        if target is not None:
+            yield k, _of(state, target)
+
+
 def next_to(program: Program, state: State) -> float:
     """Sum over objects with a ``next_to`` rule of their cost beside the best object of that category: the gap
     between the footprints (m, at most 2) plus the alignment of their facings (side by side, facing one way); 2.5
     when there is none."""
     total = 0.0
-    for k, it in enumerate(state.items):
-        target = program.objects[it.category].next_to if it.category in program.objects else None
-        if target is None:
-            continue
-        js = _of(state, target)
-        if not js:
-            total += 2.5
-            continue
+    for k, js in related(program, state, "next_to"):
         turn = (1 - np.cos(state.boxes[js, 6] - state.boxes[k, 6])) / 2
-        total += float(np.min(np.minimum(gaps(state, k, js), 2.0) + turn))
+        total += float(np.min(np.minimum(gaps(state, k, js), 2.0) + turn)) if js else 2.5
     return total
 
 
 def facing(program: Program, state: State) -> float:
     """Sum over objects with a ``facing`` rule of the alignment of their front towards the nearest object of that
-    category plus half the gap to it (m, at most 2)."""
+    category plus half the gap to it (m, at most 2); 2 when there is none."""
     total = 0.0
-    for k, it in enumerate(state.items):
-        target = program.objects[it.category].facing if it.category in program.objects else None
-        if target is None:
-            continue
-        js = _of(state, target)
+    for k, js in related(program, state, "facing"):
         if not js:
             total += 2.0
             continue
@@ -110,9 +109,7 @@ def symmetry(program: Program, state: State) -> float:
     """Reflection asymmetry of each group of objects beside one anchor (their ``next_to`` category's nearest
     object), about the anchor's centre line."""
     groups: dict[int, list[int]] = {}
-    for k, it in enumerate(state.items):
-        target = program.objects[it.category].next_to if it.category in program.objects else None
-        js = _of(state, target) if target else []
+    for k, js in related(program, state, "next_to"):
         if js:
             j = js[int(np.argmin(np.linalg.norm(state.boxes[js, :2] - state.boxes[k, :2], axis=1)))]
             groups.setdefault(j, []).append(k)
