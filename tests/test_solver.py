@@ -3,6 +3,9 @@ form, Metropolis-Hastings at a fixed temperature against the Boltzmann variance,
 worse, and a 4 x 3 m bedroom whose optimum is known (nightstands flush beside the bed)."""
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -156,3 +159,70 @@ def test_count_ranges_hold_in_every_seed(seed):
                                 seed, {"large": 60, "medium": 300, "small": 0})
     n = chain.best.count("chair")
     assert 2 <= n <= 6 and chain.best.count("table") == 1 and chain.best_score[0] == 0
+
+
+def test_the_saog_wall_distance_chain_reproduces_its_log_normal():
+    """S-AOG's wall-distance potential alone at T = 1: an object free on the floor of a 6 x 400 m hall (the side wall
+    x = 0 its nearest) samples its back's distance to that wall from the fitted log-normal (KS p > 0.01)."""
+    from scipy import stats
+
+    from pipeline.methods.saog.potentials import wall_features
+
+    mu, sigma = float(np.log(0.5)), 0.4
+    grammar = {"categories": {"box": {"wall_distance": {"mu": mu, "sigma": sigma},
+                                      "wall_angle": {"weights": [1.0], "mu": [0.0], "kappa": [1.0]}}}}
+    r = room(6.0, 400.0)
+    p = pool({"box": (0.05, 0.05, 0.05)})
+    state = empty_state(r, walls_of(r)).with_items(
+        [Item("b", "box", p.pick("box", "none", np.random.default_rng(0)), "floor", "all", (0.6, 200.0))])
+    energy = Energy(Hard(state, LIMITS), [Term("wall_distance", 1.0, lambda s: wall_features(s, grammar)[0])])
+    cfg = {"schedule": {"kind": "constant", "t0": 1.0}, "moves": {"start": {"translate": 1.0}, "end": {}}}
+    v, e, _ = energy(state)
+    backs = []
+    chain = Chain(state, (v, e), state, (v, e))
+    rng = np.random.default_rng(3)
+    proposer = Proposer({"box": Spec("box", (1, 1), "all", "floor")}, p, Steps(0.3, 0.3, 0.3, 0.0))
+    for _ in range(1500):  # 20 moves between draws
+        chain = anneal(chain, energy, proposer, {"box"}, 20, cfg, rng, record_every=1000)
+        backs.append(chain.state.boxes[0, 0] - 0.05)
+    assert stats.kstest(backs[100:], stats.lognorm(s=sigma, scale=np.exp(mu)).cdf).pvalue > 0.01
+
+
+def test_objects_left_in_a_hard_violation_are_left_out_and_named():
+    """A best state with two overlapping objects and one outside the floor: the scene keeps the first, drops the
+    other two with cause 'violation', and is partial."""
+    from pipeline.methods.solver.scene import solved_scene
+
+    r = room(4.0, 3.0)
+    p = pool({"box": (0.3, 0.3, 0.3)})
+    inst = p.pick("box", "none", np.random.default_rng(0))
+    state = empty_state(r, walls_of(r)).with_items([Item("a", "box", inst, "floor", "large", (1.0, 1.0)),
+                                                    Item("b", "box", inst, "floor", "large", (1.2, 1.0)),
+                                                    Item("c", "box", inst, "floor", "large", (3.9, 1.5))])
+    hard = Hard(state, LIMITS)
+    assert hard.counts(state) == {"collision": 1, "outside": 1, "door": 0, "overhang": 0}
+    v, e, _ = Energy(hard, [])(state)
+    scene = solved_scene(Chain(state, (v, e), state, (v, e)), hard, "s", "r", 0.1)
+    assert scene.status == "partial" and scene.room.object_ids == ["a"]
+    assert {d["id"] for d in json.loads(scene.record["drops"])} == {"b", "c"} and scene.record["violations"] == 2
+
+
+def test_a_grammar_names_its_errors_and_its_parse_trees_respect_support():
+    from pipeline.errors import InputError
+    from pipeline.methods.saog.layout import load_grammar
+    from pipeline.methods.saog.sample import parse_tree
+
+    grammar = {"categories": {"desk": {"count": {"values": [0], "probs": [1.0]}},
+                              "lamp": {"count": {"values": [2], "probs": [1.0]}, "on": "desk"},
+                              "bed": {"count": {"values": [1, 2], "probs": [0.5, 0.5]}}}}
+    counts = [parse_tree(grammar, np.random.default_rng(s)) for s in range(20)]
+    assert all(c["lamp"] == 0 and c["desk"] == 0 and c["bed"] in (1, 2) for c in counts)
+    assert {c["bed"] for c in counts} == {1, 2}
+    import tempfile
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "g.yaml"
+        path.write_text("room_type: bedroom\ncategories: {}\ngroups: []\naffordance: {}\nweights: {group: 1}\n")
+        with pytest.raises(InputError, match="g.yaml: weights: no weight for wall_distance"):
+            load_grammar(path, "bedroom")
+        with pytest.raises(InputError, match="room_type: 'bedroom', the task's is 'office'"):
+            load_grammar(path, "office")
