@@ -234,3 +234,17 @@ def test_run_time_gathers_benchmarks_per_rule_and_the_wall_clock_span(tmp_path):
     assert rows.loc["train", "share"] == pytest.approx(10 / 18, abs=1e-3)
     assert (tmp_path / "out" / "runtime.csv").read_text().splitlines()[0] == "rule,jobs,job_seconds,peak_rss_mb,share"
     assert 'data-value="30.0"' in (tmp_path / "out" / "runtime.html").read_text()  # the wall-clock span, in the page
+
+
+def test_cooccurrence_similarity_is_grains_conditional_measure():
+    """P(c1 | c2) = N(c1, c2) / N(c2); similarity = 1 - mean |P_train - P_set| over frequent distinct pairs."""
+    from pipeline.evaluation.distributions import cooccurrence, cooccurrence_similarity
+
+    train = [["bed", "nightstand"], ["bed"], ["bed", "nightstand", "desk"], ["bed", "desk"]]
+    p = cooccurrence(train, ["bed", "desk", "nightstand"])
+    assert p[0, 2] == 1.0 and p[2, 0] == 0.5 and p[1, 2] == 0.5  # P(bed|nightstand), P(nightstand|bed), P(desk|ns)
+    assert cooccurrence_similarity(train, train, 0.1) == 1.0
+    only_beds = [["bed"]] * 4  # P(desk|bed) 0.5 -> 0, P(ns|bed) 0.5 -> 0, the rest 0 where N(c2) = 0
+    expected = 1 - np.mean(np.abs(p - cooccurrence(only_beds, ["bed", "desk", "nightstand"]))[~np.eye(3, dtype=bool)])
+    assert cooccurrence_similarity(train, only_beds, 0.1) == pytest.approx(expected) and expected < 0.7
+    assert np.isnan(cooccurrence_similarity(train, [], 0.1))

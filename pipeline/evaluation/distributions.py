@@ -66,3 +66,28 @@ def _split_sizes(n: int, sizes: tuple[int, int]) -> tuple[int, int]:
 def flatten(rooms: Sequence[Sequence[str]]) -> list[str]:
     """One category label per object over rooms given as category lists."""
     return [c for room in rooms for c in room]
+
+
+def cooccurrence(rooms: Sequence[Sequence[str]], categories: list[str]) -> np.ndarray:
+    """``(c, c)`` GRAINS's conditional co-occurrence ``P(c1 | c2) = N(c1, c2) / N(c2)`` over ``rooms`` (each a list
+    of categories): the share of the rooms holding ``c2`` that also hold ``c1`` (row c1, column c2; 0 where no room
+    holds c2)."""
+    index = {c: k for k, c in enumerate(categories)}
+    has = np.zeros((len(rooms), len(categories)))
+    for i, r in enumerate(rooms):
+        has[i, [index[c] for c in set(r) if c in index]] = 1.0
+    both, single = has.T @ has, has.sum(0)
+    return np.divide(both, single[None, :], out=np.zeros_like(both), where=single[None, :] > 0)
+
+
+def cooccurrence_similarity(train: Sequence[Sequence[str]], rooms: Sequence[Sequence[str]], min_share: float) -> float:
+    """GRAINS's co-occurrence similarity (supplement section 2): the mean over pairs of distinct categories held by at
+    least ``min_share`` of the training rooms of ``1 - |P_train(c1 | c2) - P_set(c1 | c2)|`` (NaN for no room or no
+    such pair)."""
+    counts = {c: sum(c in set(r) for r in train) for c in {c for r in train for c in r}}
+    cats = sorted(c for c, n in counts.items() if n >= min_share * max(len(train), 1))
+    if not rooms or len(cats) < 2:
+        return float("nan")
+    diff = np.abs(cooccurrence(train, cats) - cooccurrence(rooms, cats))
+    off = ~np.eye(len(cats), dtype=bool)
+    return float(1.0 - diff[off].mean())

@@ -14,11 +14,11 @@ import pandas as pd
 from .. import tables
 from ..geometry.raycast import intersector_class
 from ..placement.checks import Checker
-from . import functional, intervals, power, render
+from . import distributions, functional, intervals, power, render
 from .scores import finite, floors, goals, label_maps, rule_satisfaction, scene_rows, set_counts, train_similarity
 from .sets import REAL, RoomSet
 
-SETTINGS = ("render", "walk", "collision", "out_of_bounds", "sca", "kl_eps", "functional", "power", "bootstrap",
+SETTINGS = ("render", "walk", "cooccurrence_min_share", "collision", "out_of_bounds", "sca", "kl_eps", "functional", "power", "bootstrap",
             "bootstrap_min_rooms")
 EXTRA = ["consistency", "violation", "nn_similarity", "contents_excess", "contents_missing", "functional_all"]
 
@@ -40,6 +40,9 @@ def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: 
     spans = intervals.intervals(reps)
     sets = {name: {**set_counts(rows[name], rs), **stat(rows[name], rows[REAL]), "intervals": spans[name]}
             for name, rs in by_name.items()}
+    for name, rs in by_name.items():
+        sets[name]["cooccurrence_similarity"] = distributions.cooccurrence_similarity(
+            [r.categories for r in train.rooms], [r.categories for r in rs.rooms], ev["cooccurrence_min_share"])
     sca, check = classifier_scores(config, by_name, train, real, index, threads)
     for name, score in sca.items():
         sets[name]["sca"] = score

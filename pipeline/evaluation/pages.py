@@ -17,6 +17,7 @@ FIGURES = {"scenes": "rooms scored (placed)", "attempted": "rooms the method att
            "contents_excess": "share of rooms with a category more often than any training room",
            "contents_missing": "share of rooms missing a category the training rooms hold",
            "consistency": "planned edges found again", "nn_similarity": "similarity to the nearest training room",
+           "cooccurrence_similarity": "GRAINS's co-occurrence similarity to the training rooms",
            "seconds_per_scene": "median seconds per scored room (one core)"}
 
 

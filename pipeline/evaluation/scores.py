@@ -132,7 +132,7 @@ def label_maps(rs: RoomSet, index: dict, cfg: dict) -> np.ndarray:
 
 TABLE_COLUMNS = ["scenes", "attempted", "category_kl", "count_distance", "object_collision_rate", "scene_collision_rate",
                  "out_of_bounds_rate", "walkable_share", "reachable_scenes", "consistency", "violation", "nn_similarity",
-                 "contents_excess", "contents_missing", "functional_all", "seconds_per_scene"]
+                 "contents_excess", "contents_missing", "functional_all", "cooccurrence_similarity", "seconds_per_scene"]
 
 
 def metrics_table(metrics: dict) -> pd.DataFrame:
