@@ -33,7 +33,15 @@ def real_state(room: RoomInput, parents: dict[str, str | None]) -> State:
     return State(base.room, base.walls, items, room.boxes.reshape(-1, 7), room.poses.reshape(-1, 7))
 
 
-def wall_fits(states: list[State], k_max: int) -> dict[str, dict]:
+def lognormal(x: np.ndarray, cfg: dict) -> dict:
+    """A log-normal fit of distances (m) with the grammar's floors: distances below ``distance_floor`` read as it, and
+    the log-scale spread is at least ``min_sigma`` (a category always flush against its wall would otherwise give an
+    energy that no sampled room can approach)."""
+    mu, sigma = fit_lognormal(x, floor=cfg["distance_floor"])
+    return {"mu": mu, "sigma": max(sigma, cfg["min_sigma"]), "floor": cfg["distance_floor"]}
+
+
+def wall_fits(states: list[State], cfg: dict) -> dict[str, dict]:
     """Per category of floor objects: log-normal of the back's distance to the nearest wall, von Mises mixture of
     the yaw relative to that wall's facing."""
     dist, angle = {}, {}
@@ -48,10 +56,9 @@ def wall_fits(states: list[State], k_max: int) -> dict[str, dict]:
             angle.setdefault(c, []).append(s.boxes[k, 6] - wall_yaw(s.walls, int(w[i])))
     out = {}
     for c in dist:
-        mu, sigma = fit_lognormal(np.array(dist[c]))
         theta = np.array(angle[c])
-        out[c] = {"wall_distance": {"mu": mu, "sigma": sigma},
-                  "wall_angle": fit_von_mises_mixture(theta, k=min(k_max, len(theta)))}
+        out[c] = {"wall_distance": lognormal(np.array(dist[c]), cfg),
+                  "wall_angle": fit_von_mises_mixture(theta, k=min(cfg["vonmises_components"], len(theta)))}
     return out
 
 
@@ -67,7 +74,7 @@ def support_of(nodes: pd.DataFrame) -> dict[str, str]:
     return out
 
 
-def groups_of(nodes: pd.DataFrame) -> list[dict]:
+def groups_of(nodes: pd.DataFrame, cfg: dict) -> list[dict]:
     """Functional groups: (hub category, spoke category) pairs of the final graphs' hubs, with a log-normal of the
     spoke's centre distance to its hub."""
     role = nodes["role"].astype(str)
@@ -81,8 +88,7 @@ def groups_of(nodes: pd.DataFrame) -> list[dict]:
         hub = hub.iloc[0] if isinstance(hub, pd.DataFrame) else hub
         dists.setdefault((str(hub["category"]), str(sp["category"])), []).append(
             float(np.hypot(sp["cx"] - hub["cx"], sp["cy"] - hub["cy"])))
-    return [{"hub": h, "spoke": s, **dict(zip(("mu", "sigma"), fit_lognormal(np.array(d))))}
-            for (h, s), d in sorted(dists.items()) if len(d) >= 2]
+    return [{"hub": h, "spoke": s, **lognormal(np.array(d), cfg)} for (h, s), d in sorted(dists.items()) if len(d) >= 2]
 
 
 def affordances(states: list[State], cfg: dict) -> dict:
@@ -111,7 +117,7 @@ def pool_of(rooms: list[RoomInput]) -> ModelPool:
 def grammar_of(room_type: str, states: list[State], nodes: pd.DataFrame, cfg: dict) -> dict:
     """Every piece of the grammar but the weights."""
     cats = sorted({it.category for s in states for it in s.items})
-    walls, support = wall_fits(states, cfg["vonmises_components"]), support_of(nodes)
+    walls, support = wall_fits(states, cfg), support_of(nodes)
     out = {}
     for c in cats:
         halves = np.array([s.boxes[k, 3:6] for s in states for k, it in enumerate(s.items) if it.category == c])
@@ -122,8 +128,13 @@ def grammar_of(room_type: str, states: list[State], nodes: pd.DataFrame, cfg: di
         elif c in walls:
             node |= walls[c]
         out[c] = node
-    return {"room_type": room_type, "categories": out, "groups": groups_of(nodes),
+    return {"room_type": room_type, "categories": out, "groups": groups_of(nodes, cfg),
             "affordance": affordances(states, cfg["affordance"])}
+
+
+def per_object(f: np.ndarray, state: State) -> np.ndarray:
+    """A room's potentials per object: contrastive divergence's gradient on rooms of any size (a departure)."""
+    return f / max(len(state.items), 1)
 
 
 def learn_weights(grammar: dict, states: list[State], rooms: list[RoomInput], pool: ModelPool, config: dict,
@@ -132,7 +143,7 @@ def learn_weights(grammar: dict, states: list[State], rooms: list[RoomInput], po
     those of rooms sampled under the current weights in the training architectures (short chains)."""
     cfg = config["saog"]
     preset = cfg["presets"][cfg["preset"]]
-    data = np.array([features(s, grammar) for s in states])
+    data = np.array([per_object(features(s, grammar), s) for s in states])
     limits = limits_of(config)
 
     def sample_features(w: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -141,7 +152,7 @@ def learn_weights(grammar: dict, states: list[State], rooms: list[RoomInput], po
         for k in rng.choice(len(rooms), size=preset["cd_samples"]):
             state = empty_state(rooms[k], walls_of(rooms[k]))
             chain = sample_room(grammar, weights, state, Hard(state, limits), pool, cfg, max(preset["steps"] // 10, 10), rng)
-            out.append(features(chain.best, grammar))
+            out.append(per_object(features(chain.best, grammar), chain.best))
         return np.array(out)
 
     w0 = np.array([cfg["initial_weights"][p] for p in POTENTIALS], float)

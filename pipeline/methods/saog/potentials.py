@@ -42,7 +42,7 @@ def group_feature(state: State, grammar: dict) -> float:
         for k, it in enumerate(state.items):
             if it.category == g["spoke"]:
                 d = np.linalg.norm(state.boxes[hubs, :2] - state.boxes[k, :2], axis=1).min()
-                total += float(lognormal_energy(d, g["mu"], g["sigma"]))
+                total += float(lognormal_energy(d, g["mu"], g["sigma"], g.get("floor", 1e-3)))
     return total
 
 
