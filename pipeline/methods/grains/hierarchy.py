@@ -120,13 +120,6 @@ def support_forest(ids: list[str], parents: dict[str, str | None],
     return par
 
 
-def floor_root(i: str, par: dict[str, str | None]) -> str:
-    """The floor-standing ancestor of object ``i`` in a loop-free forest."""
-    while par[i] is not None:
-        i = par[i]
-    return i
-
-
 def nearest_wall(box: np.ndarray, walls: np.ndarray) -> int:
     """Index of the wall box ``(4, 7)`` whose inner face line is nearest the footprint of ``box`` (7,)."""
     corners = footprint_corners(box[0], box[1], box[3], box[4], box[6])[0]  # (4, 2)
