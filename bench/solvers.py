@@ -12,8 +12,8 @@ import json
 import sys
 from pathlib import Path
 
-SETS = ("planit", "infinigen", "saog", "real_heldout")
-COLUMNS = ("scenes", "category_kl", "object_collision_rate", "out_of_bounds_rate", "walkable_share", "functional_all",
+SETS = ("planit", "grains", "infinigen", "saog", "real_heldout")
+COLUMNS = ("scenes", "category_kl", "cooccurrence_similarity", "object_collision_rate", "out_of_bounds_rate", "walkable_share", "functional_all",
            "sca", "seconds_per_scene")
 
 
@@ -42,7 +42,7 @@ def main() -> None:
             s = m["sets"].get(name)
             if s is None:
                 continue
-            learn = job_seconds(run, "learn_program", f"{room_type}-{name}")
+            learn = job_seconds(run, "learn_program", f"{room_type}-{name}") or job_seconds(run, "train_placement", f"{room_type}-{name}")
             gen = job_seconds(run, "generate", f"{room_type}-{name}")
             print(f"| {name} | " + " | ".join(cell(s.get(c)) for c in COLUMNS) + f" | {learn} | {gen} |")
 

@@ -264,7 +264,7 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
     from pipeline.corpus.procedural_rules import RULES
 
     res = run_dir / "results"
-    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "infinigen", "saog",
+    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "grains", "infinigen", "saog",
             "retrieval", "real_heldout"}
     for room_type in LEARNED:
         m = json.loads((res / "eval" / room_type / "metrics.json").read_text())

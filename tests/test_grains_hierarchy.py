@@ -11,8 +11,18 @@ import numpy as np
 import pytest
 
 from pipeline.methods.grains import relpos
-from pipeline.methods.grains.hierarchy import (Node, anchor, build_tree, describe, from_dict, layout, leaves,
-                                               rectangle_walls, to_dict, tree_depth)
+from pipeline.methods.grains.hierarchy import (
+    Node,
+    anchor,
+    build_tree,
+    describe,
+    from_dict,
+    layout,
+    leaves,
+    rectangle_walls,
+    to_dict,
+    tree_depth,
+)
 from pipeline.room import RoomInput
 
 BEDROOM = ("root(wall(surround(bed,support(nightstand,table_lamp),support(nightstand,table_lamp))),"

@@ -25,6 +25,7 @@ GRAPH_SOURCES = {s.name: s for s in [
 PLACEMENT_LEARNERS = {p.name: p for p in [
     *(PlacementLearner(net, "pipeline.methods.planit.nets.fit:fit_from_tables", _preset_keys("placement"))
       for net in ("cfcn", "fcn")),
+    PlacementLearner("grains", "pipeline.methods.grains.fit:fit_grains", _preset_keys("grains", "wall_gap")),
     PlacementLearner("tagger", "pipeline.methods.strings.tagfit:fit_tagger",
                      lambda config: ["seed", "strings.tagger.preset",
                                      f"strings.tagger.presets.{config['strings']['tagger']['preset']}",
@@ -76,6 +77,12 @@ BUILTIN = [
                                       "strings.tagger.placement", "strings.tagger.preset"],
            description="the string VAE's sampled graphs placed the paper's way: each edge tagged with a relative-pose "
            "cluster by the edge tagger, assembled breadth-first from the walls with repair"),
+    Method("grains", "pipeline.methods.grains.layout:GrainsLayout", model="grains",
+           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "extract", "floor_contact",
+                                      "instantiate", "evaluate.collision.penetration"],
+           scenes=lambda config, name: config["grains"]["scenes"],
+           description="GRAINS: hierarchies decoded from a recursive VAE's prior, each wall group laid onto a held-out "
+           "room's wall, models retrieved by size"),
     Method("infinigen", "pipeline.methods.infinigen.layout:InfinigenLayout", program="infinigen",
            keys=_solver_keys("infinigen"), scenes=lambda config, name: config["infinigen"]["scenes"],
            description="an Infinigen-Indoors-style constraint program per room type, derived from the training split, "

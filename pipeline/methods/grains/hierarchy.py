@@ -47,9 +47,10 @@ DEPTH_SLACK = 0.5  # m, how far beyond the centre's half depth a surround's side
 class Node:
     """One node of a room's hierarchy; see the module docstring for the children and codes of each kind."""
     kind: str                       # one of KINDS
-    children: list["Node"] = field(default_factory=list)
+    children: list[Node] = field(default_factory=list)
     codes: list[np.ndarray] = field(default_factory=list)  # (28,) relative-position codes, see below
-    half: np.ndarray | None = None  # leaf: (3,) half extents (m); wall: (3,) the wall's box half extents; root: (3,) the floor's (w/2, d/2, height/2)
+    # leaf: (3,) half extents (m); wall: (3,) the wall's box half extents; root: (3,) the floor's (w/2, d/2, height/2)
+    half: np.ndarray | None = None
     label: str | None = None        # leaf: category
     object_id: str | None = None    # leaf: the object's id (None when decoded)
     box: np.ndarray | None = None   # (7,) world box of a leaf or wall when built from a room (None when decoded)
@@ -96,7 +97,9 @@ def wall_thickness(room: RoomInput) -> float:
 
 
 def rectangle_walls(room: RoomInput) -> tuple[np.ndarray, np.ndarray]:
-    """(4,7) wall boxes of the outline's bounding rectangle, anticlockwise from the bottom edge, fronts facing in, and the rectangle (xmin, ymin, xmax, ymax). GRAINS's rooms are four-walled; an L-shaped room uses its bounding rectangle's walls (a documented departure)."""
+    """(4,7) wall boxes of the outline's bounding rectangle, anticlockwise from the bottom edge, fronts facing in,
+    and the rectangle (xmin, ymin, xmax, ymax). GRAINS's rooms are four-walled; an L-shaped room uses its bounding
+    rectangle's walls (a documented departure). Thickness: the room's median; height: the room's (m)."""
     rect = room_rect(room)
     t = wall_thickness(room)
     return np.stack([rect_wall(rect, k, t, float(room.height)) for k in range(4)]), np.array(rect)
@@ -233,8 +236,10 @@ def wall_node(box: np.ndarray, groups: list[Node], roles: dict | None, wall_gap:
     return node
 
 
-def build_tree(room: RoomInput, parents: dict[str, str | None], roles: dict[str, tuple[str, str | None]] | None = None, wall_gap: float = 0.3) -> Node:
-    """The room's hierarchy. parents: object id -> support parent id (None: floor). roles: object id -> (role, group_id) from the final graph (optional; hub/spoke roles may seed surrounds).
+def build_tree(room: RoomInput, parents: dict[str, str | None],
+               roles: dict[str, tuple[str, str | None]] | None = None, wall_gap: float = 0.3) -> Node:
+    """The room's hierarchy. parents: object id -> support parent id (None: floor). roles: object id -> (role,
+    group_id) from the final graph (optional; hub/spoke roles may seed surrounds: hubs are tried first as centres).
 
     ``wall_gap`` (m): a third of how far a surround's side may stand from its centre. Rules: module docstring.
     """

@@ -19,7 +19,7 @@ averaged over trees.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 import torch
@@ -29,7 +29,7 @@ from torch import Tensor, nn
 from . import relpos
 from .hierarchy import KINDS, Node
 
-CODE = relpos.CODE  # [0:3] reals (rotation / pi, x, y offsets in m), [3:19] two-hot, [19:23] attachment, [23:28] alignment
+CODE = relpos.CODE  # [0:3] reals (rotation / pi, x, y offsets, m), [3:19] two-hot, [19:23] attach, [23:28] align
 REALS, BITS = slice(0, 3), slice(relpos.ATTACH.start, CODE)
 # the two-hot entries of the x and y edge pairs (one bit set in each group)
 PAIR_X = [relpos.PAIRS.start + a * 4 + b for a in relpos.X_EDGES for b in relpos.X_EDGES]
@@ -173,13 +173,24 @@ class GrainsVAE(nn.Module):
         f, h, r, rh, c = sizes.feature, sizes.hidden, sizes.root_feature, sizes.root_hidden, len(self.labels)
         self.enc = nn.ModuleDict({
             "leaf": mlp(3 + c, h, f), "support": mlp(2 * f + CODE, h, f), "cooc": mlp(2 * f + CODE, h, f),
-            "surround": mlp(3 * f + 2 * CODE, h, f), "wall": mlp(3 + f + CODE + 1, h, f), "root": mlp(3 + 4 * f, rh, r)})
+            "surround": mlp(3 * f + 2 * CODE, h, f), "wall": mlp(3 + f + CODE + 1, h, f),
+            "root": mlp(3 + 4 * f, rh, r)})
         self.empty = nn.Parameter(torch.zeros(f))  # a wall without objects: its "subtree feature"
         self.to_mu, self.to_logvar = nn.Linear(r, r), nn.Linear(r, r)
         self.dec = nn.ModuleDict({
             "leaf": mlp(f, h, 3 + c), "support": mlp(f, h, 2 * f + CODE), "cooc": mlp(f, h, 2 * f + CODE),
-            "surround": mlp(f, h, 3 * f + 2 * CODE), "wall": mlp(f, h, 3 + 1 + f + CODE), "root": mlp(r, rh, 3 + 4 * f)})
+            "surround": mlp(f, h, 3 * f + 2 * CODE), "wall": mlp(f, h, 3 + 1 + f + CODE),
+            "root": mlp(r, rh, 3 + 4 * f)})
         self.classify = mlp(f, h, len(OBJECT_KINDS))
+
+    def spec(self) -> dict:
+        """What rebuilds this network (JSON): labels, sizes and scale; see :meth:`from_spec`."""
+        return {"labels": list(self.labels), "sizes": asdict(self.sizes), "scale": self.scale}
+
+    @classmethod
+    def from_spec(cls, spec: dict) -> GrainsVAE:
+        """A fresh network of :meth:`spec`'s shape (load its state dict next)."""
+        return cls(spec["labels"], Sizes(**spec["sizes"]), spec["scale"])
 
     @property
     def device(self) -> torch.device:
@@ -202,7 +213,8 @@ class GrainsVAE(nn.Module):
             for kind in OBJECT_KINDS:
                 rows = f.rows(kind, height=height)
                 if len(rows):
-                    feats = feats.index_copy(0, f.ix(rows), torch.tanh(self.enc[kind](self._enc_input(kind, rows, f, feats))))
+                    out = torch.tanh(self.enc[kind](self._enc_input(kind, rows, f, feats)))
+                    feats = feats.index_copy(0, f.ix(rows), out)
         walls = f.rows("wall")
         feats = feats.index_copy(0, f.ix(walls), torch.tanh(self.enc["wall"](self._wall_input(walls, f, feats))))
         x = torch.cat([f.half[f.ix(f.roots)]] + [feats[f.ix(f.children[f.roots, j])] for j in range(4)], 1)
@@ -255,8 +267,8 @@ class GrainsVAE(nn.Module):
         feats = self._teach_walls(walls, f, feats, terms)
         for depth in range(2, int(f.depth.max()) + 1):
             rows = np.flatnonzero((f.depth == depth) & (f.kind < len(OBJECT_KINDS)))
-            terms.add("kind", rows, fn.cross_entropy(self.classify(feats[f.ix(rows)]),
-                                                     torch.as_tensor(f.kind[rows], device=self.device), reduction="none"))
+            target = torch.as_tensor(f.kind[rows], device=self.device)
+            terms.add("kind", rows, fn.cross_entropy(self.classify(feats[f.ix(rows)]), target, reduction="none"))
             for kind in OBJECT_KINDS:
                 sub = f.rows(kind, depth=depth)
                 if len(sub):
@@ -270,7 +282,8 @@ class GrainsVAE(nn.Module):
         out = self.dec["wall"](feats[r])
         child = f.children[rows, 0]
         has = torch.as_tensor(child >= 0, device=self.device)
-        loss = sse(out[:, :3], f.half[r]) + fn.binary_cross_entropy_with_logits(out[:, 3], has.float(), reduction="none")
+        loss = sse(out[:, :3], f.half[r])
+        loss = loss + fn.binary_cross_entropy_with_logits(out[:, 3], has.float(), reduction="none")
         terms.add("recon", rows, loss + has * code_loss(out[:, 4 + n:], f.codes[r, 0]))
         full = np.flatnonzero(child >= 0)
         return feats.index_copy(0, f.ix(child[full]), torch.tanh(out[f.ix(full), 4:4 + n]))
@@ -293,75 +306,93 @@ class GrainsVAE(nn.Module):
     # ----- generation: greedy decoding of codes -----
 
     @torch.no_grad()
-    def decode(self, z: Tensor, max_depth: int = 12) -> list[Node]:
+    def decode(self, z: Tensor, max_depth: int = 12, max_nodes: int = 200) -> list[Node]:
         """One tree per row of ``z (B, root_feature)``: argmax kinds, labels and two-hot entries, bits set where their
-        logit is positive. Every tree has ``hierarchy.tree_depth <= max_depth`` (at least 3: root, walls, a leaf): a
-        node on the last level is decoded as a leaf."""
+        logit is positive. Every tree has ``hierarchy.tree_depth <= max_depth`` (at least 3: root, walls, a leaf)
+        and at most ``max_nodes`` nodes (at least 9): a node on the last level, or one whose children would pass
+        the budget (nodes are expanded level by level, in order), is decoded as a leaf."""
+        if max_depth < 3 or max_nodes < 9:
+            raise ValueError(f"max_depth {max_depth} < 3 or max_nodes {max_nodes} < 9: no room for a leaf per wall")
         z, n = z.to(self.device, torch.float32), self.sizes.feature
-        if max_depth < 3:
-            raise ValueError(f"max_depth {max_depth} < 3 (root, walls, a leaf)")
         out = self.dec["root"](z)
-        roots = [Node("root", half=self._half(row)) for row in out[:, :3]]
-        walls, feats, nodes = self._decode_walls(torch.tanh(out[:, 3:]).reshape(-1, n))
+        roots = [Node("root", half=self._half(row)) for row in out[:, :3].double().cpu().numpy()]
+        walls, feats, nodes, owner = self._decode_walls(torch.tanh(out[:, 3:]).reshape(-1, n))
         for b, root in enumerate(roots):
             root.children = walls[4 * b:4 * b + 4]
+        count = 5 + np.bincount(np.asarray(owner, dtype=np.int64), minlength=len(roots))  # nodes per tree so far
         depth = 3  # levels counted as hierarchy.tree_depth does: the root's is 1, the walls' 2
         while nodes:
-            feats, nodes = self._decode_level(feats, nodes, depth >= max_depth)
+            kinds = self._kinds(feats, owner, count, max_nodes) if depth < max_depth else np.zeros(len(nodes), int)
+            feats, nodes, owner = self._decode_level(feats, nodes, owner, kinds)
             depth += 1
         return roots
 
-    def _decode_walls(self, feats: Tensor) -> tuple[list[Node], Tensor, list[Node]]:
-        """Wall nodes from wall features ``(4B, feature)``; their subtrees' features ``(m, feature)`` and the (yet
-        empty) subtree nodes."""
+    def _decode_walls(self, feats: Tensor) -> tuple[list[Node], Tensor, list[Node], list[int]]:
+        """Wall nodes from wall features ``(4B, feature)``; their subtrees' features ``(m, feature)``, the (yet
+        empty) subtree nodes and the trees they belong to."""
         out = self.dec["wall"](feats)
-        has = (out[:, 3] > 0).tolist()
-        walls, subtrees = [], []
-        for row, full in zip(out, has):
+        rows, n = out.double().cpu().numpy(), self.sizes.feature
+        walls, subtrees, owner = [], [], []
+        for k, row in enumerate(rows):
             wall = Node("wall", half=self._half(row[:3]))
-            if full:
-                wall.children, wall.codes = [Node("leaf")], [self._code(row[4 + self.sizes.feature:])]
+            if row[3] > 0:
+                wall.children, wall.codes = [Node("leaf")], [self._code(row[4 + n:])]
                 subtrees.append(wall.children[0])
+                owner.append(k // 4)
             walls.append(wall)
-        keep = torch.as_tensor(np.flatnonzero(has), dtype=torch.long, device=self.device)
-        return walls, torch.tanh(out[keep, 4:4 + self.sizes.feature]), subtrees
+        keep = torch.as_tensor(np.flatnonzero(rows[:, 3] > 0), dtype=torch.long, device=self.device)
+        return walls, torch.tanh(out[keep, 4:4 + n]), subtrees, owner
 
-    def _decode_level(self, feats: Tensor, nodes: list[Node], leaves: bool) -> tuple[Tensor, list[Node]]:
-        """Fill ``nodes`` from their features ``(m, feature)`` (all as leaves when ``leaves``); the features of their
-        children and the (yet empty) child nodes."""
+    def _kinds(self, feats: Tensor, owner: list[int], count: np.ndarray, max_nodes: int) -> np.ndarray:
+        """Classifier kinds ``(m,)`` (indices into OBJECT_KINDS) of the features ``(m, feature)``, leaves where the
+        children would take their tree past ``max_nodes``; ``count`` (nodes per tree) grows by the children."""
+        kinds = self.classify(feats).argmax(1).cpu().numpy()
+        for i, tree in enumerate(owner):
+            grow = ARITY[OBJECT_KINDS[kinds[i]]]
+            if count[tree] + grow > max_nodes:
+                kinds[i] = 0
+            else:
+                count[tree] += grow
+        return kinds
+
+    def _decode_level(self, feats: Tensor, nodes: list[Node], owner: list[int],
+                      kinds: np.ndarray) -> tuple[Tensor, list[Node], list[int]]:
+        """Fill ``nodes`` as ``kinds`` from their features ``(m, feature)``; their children's features, the (yet
+        empty) child nodes and the trees they belong to."""
         n = self.sizes.feature
-        kinds = torch.zeros(len(nodes), dtype=torch.long) if leaves else self.classify(feats).argmax(1).cpu()
-        next_feats, next_nodes = [], []
+        next_feats, next_nodes, next_owner = [], [], []
         for k, kind in enumerate(OBJECT_KINDS):
-            sel = torch.nonzero(kinds == k).squeeze(1)
+            sel = np.flatnonzero(kinds == k)
             if not len(sel):
                 continue
-            out = self.dec[kind](feats[sel.to(self.device)])
-            for i, row in zip(sel.tolist(), out):
-                next_nodes += self._fill(nodes[i], kind, row)
+            out = self.dec[kind](feats[torch.as_tensor(sel, device=self.device)])
+            for i, row in zip(sel, out.double().cpu().numpy()):
+                kids = self._fill(nodes[i], kind, row)
+                next_nodes += kids
+                next_owner += [owner[i]] * len(kids)
             if kind != "leaf":
                 next_feats.append(torch.tanh(out[:, :ARITY[kind] * n]).reshape(-1, n))
-        return (torch.cat(next_feats) if next_feats else feats[:0]), next_nodes
+        return (torch.cat(next_feats) if next_feats else feats[:0]), next_nodes, next_owner
 
-    def _fill(self, node: Node, kind: str, out: Tensor) -> list[Node]:
+    def _fill(self, node: Node, kind: str, out: np.ndarray) -> list[Node]:
         """Set ``node`` to ``kind`` from its decoder's output row; its new (yet empty) children."""
         node.kind = kind
         if kind == "leaf":
-            node.half, node.label = self._half(out[:3]), self.labels[int(out[3:].argmax())]
+            node.half, node.label = self._half(out[:3]), self.labels[int(np.argmax(out[3:]))]
             return []
         k, start = ARITY[kind], ARITY[kind] * self.sizes.feature
         node.children = [Node("leaf") for _ in range(k)]
         node.codes = [self._code(out[start + j * CODE:start + (j + 1) * CODE]) for j in range(N_CODES[kind])]
         return node.children
 
-    def _half(self, out: Tensor) -> np.ndarray:
+    def _half(self, out: np.ndarray) -> np.ndarray:
         """Half extents (m, ``(3,)``, at least MIN_HALF) from normalised outputs."""
-        return np.maximum(out.double().cpu().numpy() * self.scale, MIN_HALF)
+        return np.maximum(np.asarray(out, float) * self.scale, MIN_HALF)
 
-    def _code(self, out: Tensor) -> np.ndarray:
+    def _code(self, out: np.ndarray) -> np.ndarray:
         """A ``(CODE,)`` code from decoder outputs: reals in metres (rotation / pi within [-1, 1]), the largest
         two-hot entry of the x and of the y edge pairs and the bits with positive logits set to 1."""
-        out = out.double().cpu().numpy()
+        out = np.asarray(out, float)
         code = np.zeros(CODE)
         code[0] = np.clip(out[0], -1.0, 1.0)
         code[1:3] = out[1:3] * self.scale

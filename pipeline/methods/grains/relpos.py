@@ -115,7 +115,8 @@ def edge_pair(code: np.ndarray, edges: tuple[int, int]) -> tuple[int, int]:
 
 
 def decode(a: np.ndarray, half_b: np.ndarray, code: np.ndarray) -> tuple[float, float, float]:
-    """b's centre x, y and yaw given a (7,), b's half extents (3,) and a code (28,) (a decoded code may be soft: use argmax of each one-hot group).
+    """b's centre x, y and yaw given a (7,), b's half extents (3,) and a code (28,) (a decoded code may be soft:
+    use argmax of each one-hot group: the x pair among its four entries, the y pair among its four).
 
     The yaw comes back wrapped into ``[-pi, pi)``; metres and radians.
     """

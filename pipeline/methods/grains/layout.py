@@ -1,0 +1,98 @@
+"""The GRAINS method: hierarchies decoded from the VAE's prior (a depth cap), each laid onto a held-out room: the
+decoded walls' groups go onto the room's bounding rectangle's walls (GRAINS decodes its own walls; the re-anchoring
+is a departure), each leaf takes the training instance of its label nearest to its decoded size (retrieval as
+PlanIT's). GRAINS checks no collisions: the evaluation measures them, nothing filters them."""
+from __future__ import annotations
+
+import time
+import zlib
+from typing import Iterator
+
+import numpy as np
+import torch
+
+from ...learning import checkpoint
+from ...log import progress
+from ...placement.layout import add_object, walls_of, with_objects
+from ...placement.retrieval import ModelPool, place
+from ..interface import Scene, Task
+from ..placing import load_context
+from .hierarchy import Node, anchor, layout, room_rect
+from .train import KIND, build_model
+
+
+def supports(tree: Node) -> dict[int, int]:
+    """Leaf index (depth first, as ``layout`` lists them) -> the index of the leaf it stands on."""
+    out: dict[int, int] = {}
+    order: dict[int, int] = {}
+
+    def walk(node: Node) -> None:
+        if node.kind == "leaf":
+            order[id(node)] = len(order)
+            return
+        for child in node.children:
+            walk(child)
+        if node.kind == "support":
+            out[id(anchor(node.children[1]))] = id(anchor(node.children[0]))
+
+    walk(tree)
+    return {order[c]: order[p] for c, p in out.items() if c in order and p in order}
+
+
+def nearest_instance(pool: ModelPool, label: str, half: np.ndarray):
+    """The training instance of ``label`` whose half extents are nearest to ``half`` (None: no such instance)."""
+    insts = pool.by_cat.get(label)
+    if not insts:
+        return None
+    return insts[int(np.argmin([np.linalg.norm(np.asarray(i.half) - half) for i in insts]))]
+
+
+def furnish(tree: Node, room, pool: ModelPool, prefix: str):
+    """The room (its architecture) with the tree's leaves laid onto its bounding rectangle, and each object's
+    support parent id; leaves whose label has no training instance are left out."""
+    placed = layout(tree, room_rect(room))
+    on = supports(tree)
+    out, ids, parents = with_objects(room, []), {}, {}
+    for k, (label, _, box) in enumerate(placed):
+        inst = nearest_instance(pool, label, box[3:6])
+        if inst is None or (k in on and on[k] not in ids):
+            continue
+        top = None
+        if k in on:
+            pb = out.boxes[out.object_ids.index(ids[on[k]])]
+            top = float(pb[2] + pb[5])
+        ids[k] = f"{prefix}_{k:02d}_{label}"
+        parents[ids[k]] = ids[on[k]] if k in on else None
+        out = add_object(out, ids[k], label, inst.model_id, *place(inst, box[0], box[1], top, box[6]))
+    return out, parents
+
+
+class GrainsLayout:
+    """``grains.scenes`` hierarchies decoded from the prior, laid onto the held-out rooms in turn."""
+
+    def __init__(self, config: dict, name: str):
+        self.config, self.name, self.cfg = config, name, config["grains"]
+        self.info = {"max_depth": self.cfg["max_depth"], "rooms": "held-out rooms' bounding rectangles"}
+
+    def generate(self, task: Task) -> Iterator[Scene]:
+        torch.set_num_threads(task.threads)
+        saved = checkpoint.load(task.model, KIND)
+        model = build_model(saved.record["labels"], saved.record["preset"])
+        model.load_state_dict(saved.state["model"])
+        model.eval()
+        ctx = load_context(self.config, task.corpus)
+        rooms, count = task.corpus.heldout(), task.count or self.cfg["scenes"]
+        if not rooms:
+            return
+        gen = torch.Generator().manual_seed(zlib.crc32(f"{self.config['seed']}/{self.name}".encode()))
+        start = time.perf_counter()
+        trees = model.decode(torch.randn(count, model.sizes.root_feature, generator=gen), self.cfg["max_depth"])
+        decode_s = (time.perf_counter() - start) / count  # decoded in one batch: each scene's share
+        for i, tree in enumerate(progress(trees, total=count, desc=f"grains {task.corpus.room_type}")):
+            start = time.perf_counter()
+            room = rooms[i % len(rooms)]
+            sid = f"gen_{task.corpus.room_type}_{i:05d}"
+            placed, parents = furnish(tree, room, ctx.pool, sid)
+            record = {"seconds": decode_s + time.perf_counter() - start,
+                      "planned_objects": len(layout(tree, room_rect(room)))}
+            yield Scene(sid, room.room_id, placed, walls_of(room), record=record, parents=parents)
