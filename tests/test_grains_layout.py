@@ -1,0 +1,43 @@
+"""GRAINS's rooms in the project's tables: a hierarchy laid onto a room with models retrieved by size gives back the
+room it was built from (categories, boxes, support parents), and laid onto a larger room keeps each wall group on its
+wall."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from pipeline.methods.grains.hierarchy import build_tree
+from pipeline.methods.grains.layout import furnish, supports
+from pipeline.placement.retrieval import ModelPool
+from pipeline.room import BOX_COLUMNS
+from test_grains_hierarchy import bedroom, make_room
+
+
+def pool_of(room) -> ModelPool:
+    rows = [{"category": c, "model_id": m, **dict(zip(BOX_COLUMNS, b)), "px": b[0], "py": b[1], "pz": b[2] - b[5],
+             "sx": 1.0, "sy": 1.0, "sz": 1.0} for c, m, b in zip(room.categories, room.model_ids, room.boxes)]
+    return ModelPool(pd.DataFrame(rows), {})
+
+
+def test_a_tree_furnished_into_its_own_room_gives_the_room_back():
+    room, parents = bedroom()
+    tree = build_tree(room, parents)
+    got, got_parents = furnish(tree, room, pool_of(room), "s")
+    assert sorted(got.categories) == sorted(room.categories)
+    for cat in set(room.categories):
+        mine = sorted(map(tuple, np.round(room.boxes[[c == cat for c in room.categories]][:, :3], 6)))
+        theirs = sorted(map(tuple, np.round(got.boxes[[c == cat for c in got.categories]][:, :3], 6)))
+        assert np.allclose(mine, theirs, atol=1e-5), cat
+    on = {got.categories[got.object_ids.index(c)]: got.categories[got.object_ids.index(p)]
+          for c, p in got_parents.items() if p is not None}
+    assert on == {"table_lamp": "nightstand"} and sum(p is not None for p in got_parents.values()) == 2
+    assert len(supports(tree)) == 2
+
+
+def test_a_larger_room_keeps_each_wall_group_on_its_wall():
+    room, parents = bedroom()
+    big = make_room(np.array([[0, 0], [6, 0], [6, 5], [0, 5]], float), [])
+    got, _ = furnish(build_tree(room, parents), big, pool_of(room), "s")
+    desk = got.boxes[got.categories.index("desk")]
+    bed = got.boxes[got.categories.index("bed")]
+    assert abs(desk[1] + desk[4] - 5.0) < 1e-6 and abs(bed[1] - bed[4]) < 1e-6  # backs on the top and bottom walls
