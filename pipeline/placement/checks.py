@@ -63,10 +63,16 @@ class Checker:
                             self.extract_cfg, self.intersector, self.box_models, anchors)
 
 
+def support_shares(children: np.ndarray, parents: np.ndarray) -> np.ndarray:
+    """``(m,)`` share of each child's footprint over its parent's (boxes ``(m, 7)`` each), vectorised."""
+    c, p = (shapely.polygons(boxes.footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6]))
+            for b in (np.asarray(children, float).reshape(-1, 7), np.asarray(parents, float).reshape(-1, 7)))
+    return shapely.area(shapely.intersection(c, p)) / np.maximum(shapely.area(c), 1e-12)
+
+
 def support_share(child: np.ndarray, parent: np.ndarray) -> float:
     """Share of the child's footprint over the parent's (boxes ``(7,)``)."""
-    c, p = (shapely.Polygon(boxes.footprint_corners(*b[[0, 1, 3, 4, 6]])[0]) for b in (child, parent))
-    return float(c.intersection(p).area / max(c.area, 1e-12))
+    return float(support_shares(child[None], parent[None])[0])
 
 
 def collision(room: RoomInput, k: int, related: set[int], checker: Checker) -> tuple[int, float] | None:

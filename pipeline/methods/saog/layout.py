@@ -19,7 +19,7 @@ from .sample import sample_room
 def load_grammar(path: Path, room_type: str) -> dict:
     """A grammar file; errors name the file and the missing or wrong field."""
     try:
-        grammar = yaml.safe_load(Path(path).read_text())
+        grammar = yaml.load(Path(path).read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml: 10x
     except (OSError, yaml.YAMLError) as exc:
         raise InputError(f"{path}: not a readable grammar ({exc})") from None
     if not isinstance(grammar, dict):

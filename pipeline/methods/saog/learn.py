@@ -180,7 +180,8 @@ def fit_grammar(config: dict, room_type: str, nodes: pd.DataFrame, edges: pd.Dat
               "(m), support parent (on) or wall distance (log-normal) and angle (von Mises mixture);\n# groups: hub -> "
               "spoke distances (log-normal); affordance: where seats and beds stand in each object's frame; weights: "
               "contrastive divergence.\n")
-    text = header + yaml.safe_dump(to_plain(grammar), sort_keys=False, default_flow_style=None, width=120)
+    text = header + yaml.dump(to_plain(grammar), Dumper=getattr(yaml, "CSafeDumper", yaml.SafeDumper), sort_keys=False,
+                               default_flow_style=None, width=120)
     return text, {"room_type": room_type, "training_rooms": len(rooms), "categories": len(grammar["categories"]),
                   "groups": len(grammar["groups"]), "weights": weights, "cd_history": history}
 

@@ -13,7 +13,7 @@ import shapely
 
 from ...geometry import boxes as gb
 from ...geometry.polygon import door_zones, outside_area
-from ...placement.checks import AREA_EPS, support_share
+from ...placement.checks import AREA_EPS, support_shares
 from .state import State
 
 HARD = ("collision", "outside", "door", "overhang")
@@ -79,8 +79,9 @@ class Hard:
         door = 0
         if self.zones is not None and len(corners):
             door = int((shapely.area(shapely.intersection(shapely.polygons(corners), self.zones)) > AREA_EPS).sum())
-        overhang = sum(support_share(state.boxes[k], state.boxes[it.parent]) < self.limits.min_support
-                       for k, it in enumerate(state.items) if it.parent >= 0)
+        on = [(k, it.parent) for k, it in enumerate(state.items) if it.parent >= 0]
+        overhang = int((support_shares(state.boxes[[k for k, _ in on]], state.boxes[[p for _, p in on]])
+                        < self.limits.min_support).sum()) if on else 0
         return {"collision": colliding_pairs(state, self.limits.collision), "outside": int(np.sum(outside)),
                 "door": door, "overhang": int(overhang)}
 
