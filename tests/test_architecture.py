@@ -84,7 +84,7 @@ def _imports(path: Path) -> set[str]:
     return out
 
 
-TORCH_HOMES = ("pipeline.methods.planit", "pipeline.methods.strings", "pipeline.learning",
+TORCH_HOMES = ("pipeline.methods.planit", "pipeline.methods.strings", "pipeline.methods.grains", "pipeline.learning",
                "pipeline.evaluation.sca")
 
 
