@@ -318,6 +318,25 @@ def test_the_annealing_methods_learn_readable_programs_and_their_rooms_are_score
         assert (res / "eval" / room_type / "energy_trace.png").stat().st_size > 10_000
 
 
+def test_grains_trains_per_room_type_and_its_rooms_are_scored_with_the_cooccurrence_similarity(run_dir):
+    """GRAINS: a recursive VAE per learned room type (its checkpoint, history and curve), rooms decoded from its prior
+    in the held-out architectures, and every set of the evaluation with GRAINS's co-occurrence similarity."""
+    from pipeline.learning import checkpoint
+    from pipeline.methods.grains.hierarchy import from_dict, tree_depth
+
+    res = run_dir / "results"
+    for room_type in LEARNED:
+        folder = res / "placement" / room_type / "grains"
+        saved = checkpoint.load(folder / "model.pt", "grains_vae")
+        assert saved.record["labels"] and tree_depth(from_dict(saved.record["example_tree"])) >= 2
+        assert len(pd.read_csv(folder / "history.csv")) >= 1 and (folder / "loss.png").stat().st_size > 5_000
+        scenes = pd.read_parquet(res / "generated" / room_type / "grains" / "scenes.parquet")
+        held = pd.read_parquet(res / "splits" / f"{room_type}.parquet").query("split == 'heldout'")["room_id"]
+        assert len(scenes) == 2 and set(scenes["source_room_id"]) <= set(held)
+        sets = json.loads((res / "eval" / room_type / "metrics.json").read_text())["sets"]
+        assert all(0.0 <= s["cooccurrence_similarity"] <= 1.0 for s in sets.values() if s["scenes"])
+
+
 def test_a_users_own_program_runs_with_planit_generate(run_dir, tmp_path):
     """``planit generate --method infinigen --program FILE``: an edited program (no bed, two to three wardrobes, ...)
     is what the rooms hold; a program with an error is refused in one line naming its file and line."""
