@@ -41,11 +41,16 @@ PROGRAM_LEARNERS = {p.name: p for p in [
 ]}
 
 
+# what methods/placing.py's load_context reads (the model pool, the checker, learned support shares and pose rules):
+# a PlanIT search setting (instantiate.samples, ...) reruns none of the methods that only share this context
+CONTEXT_KEYS = ("extract", "floor_contact", "instantiate.checks", "instantiate.pose_rules",
+                "evaluate.collision.penetration")
+
+
 def _solver_keys(section: str):
     """The keys an annealing method reads: its section, the placement checks' thresholds it takes as hard limits,
     the context it shares with PlanIT's search (model pool, learned support shares) and the walkability measure."""
-    return lambda config, name: ["seed", section, "extract", "floor_contact", "instantiate",
-                                 "evaluate.collision.penetration", "evaluate.walk"]
+    return lambda config, name: ["seed", section, *CONTEXT_KEYS, "evaluate.walk"]
 
 
 def search_keys(config: dict, name: str) -> list[str]:
@@ -78,8 +83,7 @@ BUILTIN = [
            description="the string VAE's sampled graphs placed the paper's way: each edge tagged with a relative-pose "
            "cluster by the edge tagger, assembled breadth-first from the walls with repair"),
     Method("grains", "pipeline.methods.grains.layout:GrainsLayout", model="grains",
-           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "extract", "floor_contact",
-                                      "instantiate", "evaluate.collision.penetration"],
+           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
            description="GRAINS: hierarchies decoded from a recursive VAE's prior, each wall group laid onto a held-out "
            "room's wall, models retrieved by size"),
