@@ -24,3 +24,21 @@ def write_fitted(out, fitted: Fitted) -> dict:
     tables.write_figure(out.curve, fitted.curve)
     tables.write_json(out.summary, fitted.summary)
     return fitted.summary
+
+
+def epoch_figure(history: pd.DataFrame, lines: list[tuple], title: str, ylabel: str | None = None):
+    """Curves over the epochs of a history: ``lines`` of (column name or a Series, label, line style)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    if len(history):
+        for values, label, style in lines:
+            ax.plot(history["epoch"], history[values] if isinstance(values, str) else values, label=label,
+                    linestyle=style)
+    ax.set(xlabel="epoch", title=title, **({"ylabel": ylabel} if ylabel else {}))
+    ax.legend()
+    fig.tight_layout()
+    return fig

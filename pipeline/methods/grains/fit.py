@@ -12,7 +12,7 @@ import torch
 from ...config import config_hash
 from ...learning.checkpoint import Checkpoint
 from ...learning.device import pick_device
-from ...learning.fitted import Fitted
+from ...learning.fitted import Fitted, epoch_figure
 from ...log import progress
 from ...room import RoomInput
 from . import train
@@ -67,17 +67,5 @@ def fit_grains(config: dict, room_type: str, net: str, node_df: pd.DataFrame, ed
 
 
 def _curve(history: pd.DataFrame, room_type: str):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    if len(history):
-        ax.plot(history["epoch"], history["train_loss"], label="train loss")
-        ax.plot(history["epoch"], history["validation_loss"], label="validation loss")
-        ax.plot(history["epoch"], history["train_kl"], label="train KL", linestyle=":")
-    ax.set(xlabel="epoch", ylabel="loss per tree", title=f"GRAINS VAE, {room_type}")
-    ax.legend()
-    fig.tight_layout()
-    return fig
+    return epoch_figure(history, [("train_loss", "train loss", "-"), ("validation_loss", "validation loss", "-"),
+                                  ("train_kl", "train KL", ":")], f"GRAINS VAE, {room_type}", "loss per tree")

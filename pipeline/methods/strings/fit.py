@@ -14,7 +14,7 @@ from ...graphs.data import Graph, Vocab
 from ...graphs.files import split_graphs
 from ...learning.checkpoint import Checkpoint
 from ...learning.device import pick_device
-from ...learning.fitted import Fitted
+from ...learning.fitted import Fitted, epoch_figure
 from ...log import progress
 from . import train
 from .serialize import arch_prefix, string_graph
@@ -76,16 +76,6 @@ def fit_room_type(config: dict, vocab: Vocab, graphs: list[Graph], split: dict[s
 
 
 def _curve(history: pd.DataFrame, room_type: str):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    ax.plot(history["epoch"], history["train_nll"] + history["train_kl"], label="train NLL + KL")
-    ax.plot(history["epoch"], history["validation_elbo"], label="validation ELBO (KL weight 1)")
-    ax.plot(history["epoch"], history["validation_kl"], label="validation KL", linestyle=":")
-    ax.set(xlabel="epoch", ylabel="nats per string", title=f"strings VAE, {room_type}")
-    ax.legend()
-    fig.tight_layout()
-    return fig
+    return epoch_figure(history, [(history["train_nll"] + history["train_kl"], "train NLL + KL", "-"),
+                                  ("validation_elbo", "validation ELBO (KL weight 1)", "-"),
+                                  ("validation_kl", "validation KL", ":")], f"strings VAE, {room_type}", "nats per string")

@@ -16,7 +16,7 @@ from ...graphs.data import Graph, Vocab, graphs_from_tables, vocab_of
 from ...graphs.files import split_graphs
 from ...learning.checkpoint import Checkpoint
 from ...learning.device import pick_device
-from ...learning.fitted import Fitted
+from ...learning.fitted import Fitted, epoch_figure
 from ...log import progress
 from ...placement.layout import walls_of
 from ...room import RoomInput
@@ -89,18 +89,7 @@ def fit_tagger(config: dict, room_type: str, net: str, node_df: pd.DataFrame, ed
 
 
 def _curve(history: pd.DataFrame, room_type: str):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    if len(history):
-        ax.plot(history["epoch"], history["train_loss"], label="train cross-entropy per edge")
-        ax.plot(history["epoch"], history["validation_accuracy"], label="validation accuracy (voted)")
-        ax.plot(history["epoch"], history["validation_accuracy_with_choice"], label="validation accuracy, triples with a choice",
-                linestyle=":")
-    ax.set(xlabel="epoch", title=f"edge tagger, {room_type}")
-    ax.legend()
-    fig.tight_layout()
-    return fig
+    return epoch_figure(history, [("train_loss", "train cross-entropy per edge", "-"),
+                                  ("validation_accuracy", "validation accuracy (voted)", "-"),
+                                  ("validation_accuracy_with_choice", "validation accuracy, triples with a choice", ":")],
+                        f"edge tagger, {room_type}")
