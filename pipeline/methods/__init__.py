@@ -56,10 +56,15 @@ def layout_of(method: Method, config: dict) -> LayoutGenerator:
     return _load(method.layout)(config, method.name)
 
 
+def _registered(table: dict, name: str, what: str):
+    """``table[name]``, or an error naming the known entries of the registry of ``what``."""
+    if name not in table:
+        raise InputError(f"no {what} '{name}' (known: {', '.join(sorted(table))})")
+    return table[name]
+
+
 def graph_source(name: str) -> GraphSource:
-    if name not in GRAPH_SOURCES:
-        raise InputError(f"no graph generator '{name}' (known: {', '.join(sorted(GRAPH_SOURCES))})")
-    return GRAPH_SOURCES[name]
+    return _registered(GRAPH_SOURCES, name, "graph generator")
 
 
 def graph_generator(name: str) -> GraphGenerator:
@@ -74,9 +79,7 @@ def graph_sources_of(method_names: list[str]) -> list[str]:
 
 
 def placement_learner(name: str) -> PlacementLearner:
-    if name not in PLACEMENT_LEARNERS:
-        raise InputError(f"no placement learner '{name}' (known: {', '.join(sorted(PLACEMENT_LEARNERS))})")
-    return PLACEMENT_LEARNERS[name]
+    return _registered(PLACEMENT_LEARNERS, name, "placement learner")
 
 
 def placement_fit(name: str):
@@ -90,9 +93,7 @@ def placement_nets_of(method_names: list[str]) -> list[str]:
 
 
 def program_learner(name: str) -> ProgramLearner:
-    if name not in PROGRAM_LEARNERS:
-        raise InputError(f"no program learner '{name}' (known: {', '.join(sorted(PROGRAM_LEARNERS))})")
-    return PROGRAM_LEARNERS[name]
+    return _registered(PROGRAM_LEARNERS, name, "program learner")
 
 
 def program_fit(name: str):

@@ -56,6 +56,15 @@ class ModelPool:
         return pool[int(rng.choice(same or keep))]
 
 
+def nearest(pool: ModelPool, category: str, half: np.ndarray) -> Instance | None:
+    """The training instance of ``category`` whose half extents ``(3,)`` are nearest to ``half`` (m; None: the
+    category has no instance): retrieval by a predicted size, as PlanIT retrieves the model closest to the extents."""
+    insts = pool.by_cat.get(category)
+    if not insts:
+        return None
+    return insts[int(np.argmin(np.linalg.norm(np.array([i.half for i in insts]) - half, axis=1)))]
+
+
 def place(inst: Instance, x: float, y: float, support: float | None, yaw: float) -> tuple[np.ndarray, np.ndarray]:
     """Box ``(7,)`` and pose ``(7,)`` (px, py, pz, yaw, sx, sy, sz) of the instance with its box centred on
     ``(x, y)``, turned to ``yaw``, its bottom on the ``support`` height (m), or for a floor object (None) at the

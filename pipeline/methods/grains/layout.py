@@ -8,16 +8,15 @@ import time
 import zlib
 from typing import Iterator
 
-import numpy as np
 import torch
 
 from ...learning import checkpoint
 from ...log import progress
 from ...placement.layout import add_object, walls_of, with_objects
-from ...placement.retrieval import ModelPool, place
+from ...placement.retrieval import ModelPool, nearest, place
 from ..interface import Scene, Task
 from ..placing import load_context
-from .hierarchy import Node, anchor, layout, room_rect
+from .hierarchy import Node, anchor, layout, leaves, room_rect
 from .train import KIND, build_model
 
 
@@ -39,14 +38,6 @@ def supports(tree: Node) -> dict[int, int]:
     return {order[c]: order[p] for c, p in out.items() if c in order and p in order}
 
 
-def nearest_instance(pool: ModelPool, label: str, half: np.ndarray):
-    """The training instance of ``label`` whose half extents are nearest to ``half`` (None: no such instance)."""
-    insts = pool.by_cat.get(label)
-    if not insts:
-        return None
-    return insts[int(np.argmin([np.linalg.norm(np.asarray(i.half) - half) for i in insts]))]
-
-
 def furnish(tree: Node, room, pool: ModelPool, prefix: str):
     """The room (its architecture) with the tree's leaves laid onto its bounding rectangle, and each object's
     support parent id; leaves whose label has no training instance are left out."""
@@ -54,7 +45,7 @@ def furnish(tree: Node, room, pool: ModelPool, prefix: str):
     on = supports(tree)
     out, ids, parents = with_objects(room, []), {}, {}
     for k, (label, _, box) in enumerate(placed):
-        inst = nearest_instance(pool, label, box[3:6])
+        inst = nearest(pool, label, box[3:6])
         if inst is None or (k in on and on[k] not in ids):
             continue
         top = None
@@ -94,5 +85,5 @@ class GrainsLayout:
             sid = f"gen_{task.corpus.room_type}_{i:05d}"
             placed, parents = furnish(tree, room, ctx.pool, sid)
             record = {"seconds": decode_s + time.perf_counter() - start,
-                      "planned_objects": len(layout(tree, room_rect(room)))}
+                      "planned_objects": len(leaves(tree))}
             yield Scene(sid, room.room_id, placed, walls_of(room), record=record, parents=parents)

@@ -68,7 +68,14 @@ def features(state: State, grammar: dict) -> np.ndarray:
 
 
 def terms_of(grammar: dict, weights: dict) -> list[Term]:
-    """The weighted potentials as solver terms."""
-    fns = {"wall_distance": lambda s: wall_features(s, grammar)[0], "wall_angle": lambda s: wall_features(s, grammar)[1],
+    """The weighted potentials as solver terms (the two wall terms share one pass over the state)."""
+    last: dict = {}
+
+    def walls(s: State) -> tuple[float, float]:
+        if last.get("state") is not s:
+            last.update(state=s, value=wall_features(s, grammar))
+        return last["value"]
+
+    fns = {"wall_distance": lambda s: walls(s)[0], "wall_angle": lambda s: walls(s)[1],
            "group": lambda s: group_feature(s, grammar), "affordance": lambda s: affordance_feature(s, grammar)}
     return [Term(name, float(weights[name]), fns[name]) for name in POTENTIALS]

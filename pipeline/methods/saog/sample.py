@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...placement.retrieval import Instance, ModelPool
+from ...placement.retrieval import Instance, ModelPool, nearest
 from ..solver.anneal import Chain, solve
 from ..solver.moves import Proposer, Spec, Steps
 from ..solver.state import State
@@ -28,11 +28,9 @@ def sized_pick(grammar: dict, pool: ModelPool):
     """``pick(spec, rng)``: a size drawn from the category's kernel density over the training instances' half
     extents, and the instance whose extents are nearest to it."""
     def pick(spec: Spec, rng: np.random.Generator) -> Instance:
-        insts = pool.by_cat[spec.category]
-        points = np.array([i.half for i in insts])
+        points = np.array([i.half for i in pool.by_cat[spec.category]])
         bw = grammar["categories"][spec.category].get("size_bandwidth", [0.01] * 3)
-        size = sample_size({"points": points, "bandwidth": bw}, rng)[0]
-        return insts[int(np.argmin(np.linalg.norm(points - size, axis=1)))]
+        return nearest(pool, spec.category, sample_size({"points": points, "bandwidth": bw}, rng)[0])
     return pick
 
 

@@ -143,7 +143,7 @@ class Proposer:
         oid = old.object_id if old is not None else f"{self.prefix}_{self.made:03d}_{spec.category}"
         base = Item(oid, spec.category, inst, spec.dof, spec.stage, (0.0, 0.0))
         rest = [it for it in state.items if it.object_id != oid]
-        before = None if self.violations is None else self.violations(state.with_items(rest))
+        before = None if self.violations is None else self.violations(state if old is None else state.with_items(rest))
         it = None
         for _ in range(self.attempts):
             it = self.pose(state, spec, base, rng, old)

@@ -4,33 +4,21 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
-
-from ...geometry import boxes as gb
 from ..interface import Scene
 from .anneal import Chain
 from .moves import drop_items
 from .state import State
-from ...placement.checks import support_share
-from .terms import Hard, related_mask
+from .terms import Hard
 
 
 def violators(state: State, hard: Hard) -> list[int]:
-    """Items in a hard violation: the later of each colliding pair, then any footprint outside or in a door zone,
-    then any overhanging object (the caller drops the first and asks again)."""
-    depth = gb.penetration_depths(state.boxes)
-    bad = np.triu((depth > hard.limits.collision) & ~related_mask(state), 1)
-    if bad.any():
-        return [int(np.nonzero(bad)[1][0])]
-    for k, it in enumerate(state.items):
-        if it.parent >= 0:
-            if support_share(state.boxes[k], state.boxes[it.parent]) < hard.limits.min_support:
-                return [k]
-            continue
-        counts = hard.counts(State(state.room, state.walls, [it], state.boxes[k:k + 1], state.poses[k:k + 1]))
-        if counts["outside"] or counts["door"]:
-            return [k]
-    return []
+    """Items in a hard violation: the later item of the first colliding pair, else the first item outside the floor,
+    in a door zone or overhanging (the caller drops the first and asks again)."""
+    found = hard.offenders(state)
+    if found["collision"]:
+        return found["collision"][:1]
+    rest = sorted({k for kind in ("outside", "door", "overhang") for k in found[kind]})
+    return rest[:1]
 
 
 def repaired(state: State, hard: Hard) -> tuple[State, list[dict]]:

@@ -51,13 +51,15 @@ def related_mask(state: State) -> np.ndarray:
     return rel
 
 
-def colliding_pairs(state: State, limit: float) -> int:
+def colliding_pairs(state: State, limit: float) -> np.ndarray:
+    """``(m, 2)`` index pairs ``(i, j)``, ``i < j``, that penetrate deeper than ``limit`` m, not parent and child, in
+    row-major order."""
     depth = gb.penetration_depths(state.boxes)
-    return int(np.triu((depth > limit) & ~related_mask(state), 1).sum())
+    return np.argwhere(np.triu((depth > limit) & ~related_mask(state), 1))
 
 
 class Hard:
-    """Counts a state's hard violations; the room's door zones are built once."""
+    """A state's hard violations; the room's door zones are built once."""
 
     def __init__(self, state: State, limits: Limits):
         self.limits = limits
@@ -70,20 +72,27 @@ class Hard:
         return sum(self.counts(state).values())
 
     def counts(self, state: State) -> dict[str, int]:
-        """Violations per hard constraint."""
+        """Violations per hard constraint (colliding pairs; objects outside, in a door zone, overhanging)."""
+        return {kind: len(ks) for kind, ks in self.offenders(state).items()}
+
+    def offenders(self, state: State) -> dict[str, list[int]]:
+        """Per hard constraint, the items in violation: the later item of each colliding pair (one entry per pair),
+        the grounded items outside the floor or in a door's clearance zone, the supported items overhanging."""
         if not state.items:
-            return dict.fromkeys(HARD, 0)
-        grounded = np.array([it.parent < 0 for it in state.items])
+            return {kind: [] for kind in HARD}
+        grounded = np.array([k for k, it in enumerate(state.items) if it.parent < 0], int)
         corners = footprints(state.boxes[grounded])
-        outside = outside_area(state.room.outline, corners, self.limits.outside) > AREA_EPS if len(corners) else []
-        door = 0
-        if self.zones is not None and len(corners):
-            door = int((shapely.area(shapely.intersection(shapely.polygons(corners), self.zones)) > AREA_EPS).sum())
-        on = [(k, it.parent) for k, it in enumerate(state.items) if it.parent >= 0]
-        overhang = int((support_shares(state.boxes[[k for k, _ in on]], state.boxes[[p for _, p in on]])
-                        < self.limits.min_support).sum()) if on else 0
-        return {"collision": colliding_pairs(state, self.limits.collision), "outside": int(np.sum(outside)),
-                "door": door, "overhang": int(overhang)}
+        outside, door = np.zeros(len(grounded), bool), np.zeros(len(grounded), bool)
+        if len(corners):
+            outside = outside_area(state.room.outline, corners, self.limits.outside) > AREA_EPS
+            if self.zones is not None:
+                door = shapely.area(shapely.intersection(shapely.polygons(corners), self.zones)) > AREA_EPS
+        on = np.array([k for k, it in enumerate(state.items) if it.parent >= 0], int)
+        parents = np.array([state.items[k].parent for k in on], int)
+        over = support_shares(state.boxes[on], state.boxes[parents]) < self.limits.min_support if len(on) else []
+        return {"collision": colliding_pairs(state, self.limits.collision)[:, 1].tolist(),
+                "outside": grounded[outside].tolist(), "door": grounded[door].tolist(),
+                "overhang": on[np.asarray(over, bool)].tolist()}
 
 
 class Energy:
