@@ -264,8 +264,8 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
     from pipeline.corpus.procedural_rules import RULES
 
     res = run_dir / "results"
-    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "grains", "infinigen", "saog",
-            "retrieval", "real_heldout"}
+    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "grains", "grains_decoded",
+            "infinigen", "saog", "retrieval", "real_heldout"}
     for room_type in LEARNED:
         m = json.loads((res / "eval" / room_type / "metrics.json").read_text())
         assert set(m["sets"]) == sets
@@ -335,6 +335,30 @@ def test_grains_trains_per_room_type_and_its_rooms_are_scored_with_the_cooccurre
         assert len(scenes) == 2 and set(scenes["source_room_id"]) <= set(held)
         sets = json.loads((res / "eval" / room_type / "metrics.json").read_text())["sets"]
         assert all(0.0 <= s["cooccurrence_similarity"] <= 1.0 for s in sets.values() if s["scenes"])
+
+
+def test_grains_decoded_furnishes_the_same_trees_in_the_rooms_they_decode(run_dir):
+    """GRAINS's faithful mode: the same decoded trees as grains (the same categories scene by scene), each in its own
+    room: a rectangle centred on the origin with four walls and no doors or windows, written as the scene's own
+    architecture (no source room), which the evaluation reads like any other."""
+    res = run_dir / "results"
+    for room_type in LEARNED:
+        gen = res / "generated" / room_type
+        cats = {m: {r.removeprefix(f"{m}_"): c for r, c in pd.read_parquet(gen / m / "objects.parquet")
+                    .groupby("room_id")["category"].apply(sorted).items()} for m in ("grains", "grains_decoded")}
+        assert cats["grains"] == cats["grains_decoded"] and cats["grains"]
+        rooms = pd.read_parquet(gen / "grains_decoded" / "rooms.parquet")
+        arch = pd.read_parquet(gen / "grains_decoded" / "architecture.parquet")
+        scenes = pd.read_parquet(gen / "grains_decoded" / "scenes.parquet")
+        assert scenes["source_room_id"].isna().all()
+        assert (arch.groupby("room_id")["kind"].apply(list) == pd.Series([["wall"] * 4] * len(rooms),
+                                                                          index=sorted(rooms["room_id"]))).all()
+        for r in rooms.itertuples():
+            x, y = np.asarray(r.floor_x), np.asarray(r.floor_y)
+            assert len(x) == 4 and np.allclose(x.sum(), 0) and np.allclose(y.sum(), 0) and r.floor_area > 0
+            assert np.isclose(r.floor_area, np.ptp(x) * np.ptp(y)) and r.height > 0
+        sets = json.loads((res / "eval" / room_type / "metrics.json").read_text())["sets"]
+        assert sets["grains_decoded"]["scenes"] == len(rooms)
 
 
 def test_a_users_own_program_runs_with_planit_generate(run_dir, tmp_path):

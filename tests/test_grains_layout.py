@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from pipeline.methods.grains.hierarchy import build_tree
+from pipeline.methods.grains.hierarchy import build_tree, decoded_room
 from pipeline.methods.grains.layout import furnish, supports
 from pipeline.placement.retrieval import ModelPool
 from pipeline.room import BOX_COLUMNS
@@ -41,3 +41,20 @@ def test_a_larger_room_keeps_each_wall_group_on_its_wall():
     desk = got.boxes[got.categories.index("desk")]
     bed = got.boxes[got.categories.index("bed")]
     assert abs(desk[1] + desk[4] - 5.0) < 1e-6 and abs(bed[1] - bed[4]) < 1e-6  # backs on the top and bottom walls
+
+
+def test_a_tree_furnishes_the_room_it_decodes_the_source_room_moved_to_the_origin():
+    """The faithful mode: the 4 x 3 m bedroom's tree names its own room (centred on the origin, four walls of the
+    source's thickness, its height, no openings); furnishing it gives the source room shifted by (-2, -1.5) m."""
+    room, parents = bedroom()
+    tree = build_tree(room, parents)
+    own = decoded_room(tree, "gen_0", "bedroom")
+    assert np.allclose(own.outline, [[-2, -1.5], [2, -1.5], [2, 1.5], [-2, 1.5]]) and own.height == 2.6
+    assert own.wall_ids == [f"wall_{k}" for k in range(4)] and np.allclose(own.wall_thickness, 0.1)
+    assert own.openings == [] and own.object_ids == []
+    assert np.allclose(own.wall_segments[:, 1], np.roll(own.outline, -1, 0))
+    got, _ = furnish(tree, own, pool_of(room), "s")
+    for cat in set(room.categories):
+        mine = sorted(map(tuple, np.round(room.boxes[[c == cat for c in room.categories]][:, :3] - [2, 1.5, 0], 6)))
+        theirs = sorted(map(tuple, np.round(got.boxes[[c == cat for c in got.categories]][:, :3], 6)))
+        assert np.allclose(mine, theirs, atol=1e-5), cat

@@ -77,9 +77,10 @@ class Task:
 class Scene:
     """One generated room. ``room`` holds the placed objects (its room id is the scene id); ``record``: the
     method's figures for the scenes table (search counts, consistency, ...); ``edges``: the planned graph drawn in
-    the scene's PNG; ``parents``: object id -> support parent id."""
+    the scene's PNG; ``parents``: object id -> support parent id. A method that decodes its own architecture
+    (GRAINS's faithful mode) sets ``own_architecture`` and no source room: the scene's walls are ``room``'s."""
     scene_id: str
-    source_room_id: str
+    source_room_id: str | None
     room: RoomInput
     walls: Walls
     status: str = "placed"
@@ -87,6 +88,7 @@ class Scene:
     record: dict = field(default_factory=dict)
     edges: list = field(default_factory=list)
     parents: dict = field(default_factory=dict)
+    own_architecture: bool = False
 
 
 class LayoutGenerator(Protocol):

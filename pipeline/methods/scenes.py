@@ -9,9 +9,11 @@ import json
 import logging
 from dataclasses import dataclass, field, replace
 
+import numpy as np
 import pandas as pd
 
 from .. import tables
+from ..corpus.rows import room_row, wall_rows
 from ..errors import InputError
 from ..placement import export
 from ..placement.search import SCORED
@@ -39,10 +41,13 @@ class Rows:
         self.records.append(record)
         if scene.status not in SCORED:
             return record
-        src = tables.records(corpus.rooms[corpus.rooms["room_id"] == scene.source_room_id])[0]
-        self.rooms.append({**src, "room_id": scene.scene_id, "n_objects": len(room.object_ids), "shard": 0})
-        arch = corpus.architecture[corpus.architecture["room_id"] == scene.source_room_id]
-        self.architecture += tables.records(arch.assign(room_id=scene.scene_id))
+        if scene.own_architecture:
+            self._add_own_architecture(scene, corpus)
+        else:
+            src = tables.records(corpus.rooms[corpus.rooms["room_id"] == scene.source_room_id])[0]
+            self.rooms.append({**src, "room_id": scene.scene_id, "n_objects": len(room.object_ids), "shard": 0})
+            arch = corpus.architecture[corpus.architecture["room_id"] == scene.source_room_id]
+            self.architecture += tables.records(arch.assign(room_id=scene.scene_id))
         self.objects += [{"room_id": scene.scene_id, "scene_id": scene.scene_id, "object_id": o, "category": c,
                           "model_id": m, **dict(zip(BOX_COLUMNS, map(float, b))),
                           **dict(zip(["px", "py", "pz", "_yaw", "sx", "sy", "sz"], map(float, p))),
@@ -50,6 +55,16 @@ class Rows:
                          for o, c, m, b, p in zip(room.object_ids, room.categories, room.model_ids, room.boxes,
                                                   room.poses)]
         return record
+
+
+    def _add_own_architecture(self, scene: Scene, corpus: Corpus) -> None:
+        """The rooms row and wall rows of a scene whose method decoded its own walls (``scene.room``'s outline)."""
+        room = scene.room
+        source = str(corpus.rooms["source"].iloc[0]) if len(corpus.rooms) else "generated"
+        self.rooms.append(room_row(scene.scene_id, source, corpus.room_type, corpus.room_type, room.outline,
+                                   room.height, len(room.object_ids), shard=0))
+        self.architecture += wall_rows(scene.scene_id, room.outline, room.height,
+                                       float(np.median(room.wall_thickness)))
 
 
 def write_scene_files(archive: tables.Archive, scene: Scene, record: dict, mesh_of) -> None:

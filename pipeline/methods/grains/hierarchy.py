@@ -294,6 +294,22 @@ def layout(tree: Node, rect: tuple[float, float, float, float]) -> list[tuple[st
     return out
 
 
+def decoded_room(tree: Node, room_id: str, room_type: str) -> RoomInput:
+    """The room a decoded tree names itself (GRAINS's own walls, the faithful mode): the rectangle of the root's
+    floor half extents centred on the origin, four walls anticlockwise from the bottom one (``wall_<k>`` is the
+    tree's wall ``k``) with the decoded walls' median thickness, the root's height, no doors or windows, no objects."""
+    half = np.asarray(tree.half if tree.half is not None else [1.0, 1.0, DEFAULT_HEIGHT / 2], float)
+    (hx, hy, hz) = half
+    outline = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+    thick = [2 * float(w.half[1]) for w in tree.children[:4] if w.half is not None]
+    return RoomInput(room_id=room_id, room_type=room_type, height=2 * float(hz), outline=outline,
+                     wall_ids=[f"wall_{k}" for k in range(4)],
+                     wall_segments=np.stack([outline, np.roll(outline, -1, axis=0)], 1),
+                     wall_thickness=np.full(4, float(np.median(thick)) if thick else DEFAULT_THICKNESS),
+                     openings=[], object_ids=[], categories=[], model_ids=[], boxes=np.zeros((0, 7)),
+                     poses=np.zeros((0, 7)))
+
+
 def tree_depth(node: Node) -> int:
     """Levels from ``node`` down to its deepest leaf (a leaf or a childless node: 1)."""
     return 1 + max((tree_depth(c) for c in node.children), default=0)

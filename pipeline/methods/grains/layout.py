@@ -1,7 +1,10 @@
 """The GRAINS method: hierarchies decoded from the VAE's prior (a depth cap), each laid onto a held-out room: the
 decoded walls' groups go onto the room's bounding rectangle's walls (GRAINS decodes its own walls; the re-anchoring
 is a departure), each leaf takes the training instance of its label nearest to its decoded size (retrieval as
-PlanIT's). GRAINS checks no collisions: the evaluation measures them, nothing filters them."""
+PlanIT's). GRAINS checks no collisions: the evaluation measures them, nothing filters them.
+
+:class:`GrainsDecoded` is the faithful mode (method ``grains_decoded``): each tree furnishes the rectangle its own
+root decodes (:func:`.hierarchy.decoded_room`: no doors or windows), written as the scene's own architecture."""
 from __future__ import annotations
 
 import time
@@ -14,9 +17,10 @@ from ...learning import checkpoint
 from ...log import progress
 from ...placement.layout import add_object, walls_of, with_objects
 from ...placement.retrieval import ModelPool, nearest, place
+from ...room import RoomInput
 from ..interface import Scene, Task
 from ..placing import load_context
-from .hierarchy import Node, anchor, layout, leaves, room_rect
+from .hierarchy import Node, anchor, decoded_room, layout, leaves, room_rect
 from .train import KIND, build_model
 
 
@@ -60,10 +64,17 @@ def furnish(tree: Node, room, pool: ModelPool, prefix: str):
 
 class GrainsLayout:
     """``grains.scenes`` hierarchies decoded from the prior, laid onto the held-out rooms in turn."""
+    rooms_info = "held-out rooms' bounding rectangles"
+    own_architecture = False
 
     def __init__(self, config: dict, name: str):
         self.config, self.name, self.cfg = config, name, config["grains"]
-        self.info = {"max_depth": self.cfg["max_depth"], "rooms": "held-out rooms' bounding rectangles"}
+        self.info = {"max_depth": self.cfg["max_depth"], "rooms": self.rooms_info}
+
+    def room_for(self, tree: Node, k: int, scene_id: str, corpus) -> RoomInput:
+        """The architecture scene ``k`` is laid onto: the held-out rooms in turn."""
+        rooms = corpus.heldout()
+        return rooms[k % len(rooms)]
 
     def generate(self, task: Task) -> Iterator[Scene]:
         torch.set_num_threads(task.threads)
@@ -72,18 +83,29 @@ class GrainsLayout:
         model.load_state_dict(saved.state["model"])
         model.eval()
         ctx = load_context(self.config, task.corpus)
-        rooms, count = task.corpus.heldout(), task.count or self.cfg["scenes"]
-        if not rooms:
+        count = task.count or self.cfg["scenes"]
+        if not task.corpus.heldout():
             return
-        gen = torch.Generator().manual_seed(zlib.crc32(f"{self.config['seed']}/{self.name}".encode()))
+        # one seed for both modes: grains and grains_decoded furnish the same trees, in different rooms
+        gen = torch.Generator().manual_seed(zlib.crc32(f"{self.config['seed']}/grains".encode()))
         start = time.perf_counter()
         trees = model.decode(torch.randn(count, model.sizes.root_feature, generator=gen), self.cfg["max_depth"])
         decode_s = (time.perf_counter() - start) / count  # decoded in one batch: each scene's share
-        for i, tree in enumerate(progress(trees, total=count, desc=f"grains {task.corpus.room_type}")):
+        own = self.own_architecture
+        for i, tree in enumerate(progress(trees, total=count, desc=f"{self.name} {task.corpus.room_type}")):
             start = time.perf_counter()
-            room = rooms[i % len(rooms)]
             sid = f"gen_{task.corpus.room_type}_{i:05d}"
+            room = self.room_for(tree, i, sid, task.corpus)
             placed, parents = furnish(tree, room, ctx.pool, sid)
-            record = {"seconds": decode_s + time.perf_counter() - start,
-                      "planned_objects": len(leaves(tree))}
-            yield Scene(sid, room.room_id, placed, walls_of(room), record=record, parents=parents)
+            record = {"seconds": decode_s + time.perf_counter() - start, "planned_objects": len(leaves(tree))}
+            yield Scene(sid, None if own else room.room_id, placed, walls_of(placed), record=record,
+                        parents=parents, own_architecture=own)
+
+
+class GrainsDecoded(GrainsLayout):
+    """GRAINS's faithful mode: each tree furnishes the room its own root and walls decode."""
+    rooms_info = "the rooms the trees decode (own walls, no doors or windows)"
+    own_architecture = True
+
+    def room_for(self, tree: Node, k: int, scene_id: str, corpus) -> RoomInput:
+        return decoded_room(tree, scene_id, corpus.room_type)
