@@ -12,7 +12,7 @@ import json
 import sys
 from pathlib import Path
 
-SETS = ("planit", "grains", "infinigen", "saog", "real_heldout")
+SETS = ("planit", "grains", "grains_decoded", "infinigen", "saog", "real_heldout")
 COLUMNS = ("scenes", "category_kl", "cooccurrence_similarity", "object_collision_rate", "out_of_bounds_rate", "walkable_share", "functional_all",
            "sca", "seconds_per_scene")
 
