@@ -196,3 +196,24 @@ def test_training_resumes_exactly_and_starts_over_under_another_hash(tmp_path):
         assert torch.equal(p, q)
     other = train.train(fit, val, LABELS, SMALL, 5, tmp_path / "b.pt", "h2", "cpu")
     assert other.resumed_from == 0 and strip(other.history) == strip(whole.history)
+
+
+def test_selection_by_samples_keeps_the_checked_epoch_whose_prior_is_nearest_the_validation_rooms(tmp_path):
+    """``select: samples``: every ``select_every`` epochs the prior's samples are scored against the validation
+    trees (category KL), the kept weights are those of the lowest score, and they reproduce it."""
+    fit, val = small_rooms(12, 3), small_rooms(4, 4)
+    preset = {**SMALL, "max_epochs": 6, "patience": 6, "select": "samples", "select_every": 2, "select_samples": 8}
+    run = train.train(fit, val, LABELS, preset, 5, tmp_path / "a.pt", "h1", "cpu")
+    checked = {r["epoch"]: r["sample_kl"] for r in run.history if "sample_kl" in r}
+    assert list(checked) == [2, 4, 6] and all(np.isfinite(v) and v >= 0 for v in checked.values())
+    assert run.best_epoch == min(checked, key=checked.get)
+    assert train.sample_kl(run.model, val, preset, 5) == pytest.approx(checked[run.best_epoch], abs=1e-9)
+
+
+def test_selection_by_samples_stops_after_patience_epochs_without_a_gain(tmp_path):
+    """Patience counts epochs, checked or not: with a check every 2 epochs and patience 3, a run stops at most 3
+    epochs after its best check."""
+    fit, val = small_rooms(12, 3), small_rooms(4, 4)
+    preset = {**SMALL, "max_epochs": 40, "patience": 3, "select": "samples", "select_every": 2, "select_samples": 8}
+    run = train.train(fit, val, LABELS, preset, 5, tmp_path / "a.pt", "h1", "cpu")
+    assert len(run.history) < 40 and len(run.history) - run.best_epoch <= 3
