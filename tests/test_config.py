@@ -140,3 +140,13 @@ def test_default_run_places_30_rooms_per_type_and_caps_the_baselines_at_30():
     assert counts["heldout"] == ic["table3_scenes"] == 20
     tiny = config.load(ROOT / "config" / "tiny.yaml")["instantiate"]
     assert {scene_count(tiny, v) for v in tiny["variants"].values()} == {2}  # the cap never raises a count
+
+
+def test_grains_selection_by_samples_needs_its_period_and_sample_count(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("grains:\n  presets:\n    default: {feature: 8, hidden: 8, root_feature: 8, root_hidden: 8, batch_size: 4,"
+                   " lr: 0.001, max_epochs: 5, patience: 5, kl_weight: 0.1, select: samples}\n")
+    with pytest.raises(config.ConfigError, match=r"bad.yaml: invalid config at key 'grains.presets.default'.*select_every"):
+        config.load(bad)
+    bad.write_text(bad.read_text().replace("select: samples}", "select: samples, select_every: 2, select_samples: 4}"))
+    assert config.load(bad)["grains"]["presets"]["default"]["select_every"] == 2
