@@ -208,3 +208,39 @@ def test_dict_round_trip():
     assert decoded.box is None and decoded.object_id is None
     with pytest.raises(ValueError):
         from_dict({"kind": "tree"})
+
+
+def test_snapping_a_true_code_moves_a_box_by_at_most_the_contact_tolerance():
+    """On an exact code the bits agree with the reals up to ``eps``: snapping moves the centre by <= eps (m) per
+    axis, plus how much squaring a box turned under 1 degree (the same-yaw bit's tolerance) changes its bound, and
+    the yaw by <= 1 degree."""
+    rng = np.random.default_rng(11)
+    for k in range(300):
+        a = random_box(rng, aligned=True)
+        b = random_box(rng, aligned=k % 2 == 0)
+        if k % 3 == 0:  # touch a's right side, same yaw, backs collinear
+            b = np.array([a[0], a[1], 0, *b[3:6], a[6]])
+            d = np.array([a[3] + b[3], b[4] - a[4]])
+            b[:2] = a[:2] + relpos.rotation(a[6]) @ d
+        code = relpos.encode(a, b)
+        x, y, yaw = relpos.decode(a, b[3:6], code, snap=True)
+        squared = relpos.extents(code[relpos.ROT] * math.pi, b[3:6]) - b[3:5] if code[relpos.ALIGN][2] else 0.0
+        assert math.hypot(x - b[0], y - b[1]) <= 0.01 * math.sqrt(2) + np.linalg.norm(squared) + 1e-9
+        assert yaw_error(yaw, b[6]) <= math.radians(1.0) + 1e-9
+
+
+def test_snapping_a_noisy_decoded_code_restores_what_its_bits_state():
+    """A nightstand flush against the bed's right side, backs collinear: with its reals off (turned 9 degrees,
+    offsets 7 cm out), the reals alone leave a gap and a turn; snapped, it touches, is square and lines up."""
+    bed = box(2.0, 1.0, 0.8, 1.0, 0.3)
+    stand = box(3.05, 0.25, 0.25, 0.25, 0.275)
+    code = relpos.encode(bed, stand)
+    assert code[relpos.ATTACH][3] == 1 and code[relpos.ALIGN][[2, 4]].tolist() == [1, 1]
+    noisy = code.copy()
+    noisy[relpos.ROT] += 0.05
+    noisy[relpos.OFF_X] += 0.07
+    noisy[relpos.OFF_Y] += 0.07
+    x, y, yaw = relpos.decode(bed, stand[3:6], noisy)
+    assert abs(x - 3.05) > 0.05 and abs(yaw) > math.radians(8)
+    x, y, yaw = relpos.decode(bed, stand[3:6], noisy, snap=True)
+    assert (x, y, yaw) == pytest.approx((3.05, 0.25, 0.0), abs=1e-9)

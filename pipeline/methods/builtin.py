@@ -83,12 +83,12 @@ BUILTIN = [
            description="the string VAE's sampled graphs placed the paper's way: each edge tagged with a relative-pose "
            "cluster by the edge tagger, assembled breadth-first from the walls with repair"),
     Method("grains", "pipeline.methods.grains.layout:GrainsLayout", model="grains",
-           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", *CONTEXT_KEYS],
+           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "grains.snap", *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
            description="GRAINS: hierarchies decoded from a recursive VAE's prior, each wall group laid onto a held-out "
            "room's wall, models retrieved by size"),
     Method("grains_decoded", "pipeline.methods.grains.layout:GrainsDecoded", model="grains",
-           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", *CONTEXT_KEYS],
+           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "grains.snap", *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
            description="GRAINS's faithful mode: the same hierarchies, each furnishing the rectangle its own root and "
            "walls decode (no doors or windows), models retrieved by size"),

@@ -258,13 +258,14 @@ def build_tree(room: RoomInput, parents: dict[str, str | None],
     return Node("root", [wall_node(walls[k], groups[k], roles, wall_gap) for k in range(4)], half=half)
 
 
-def placed(ref: np.ndarray, half: np.ndarray, code: np.ndarray, base: float) -> np.ndarray:
-    """``(7,)`` box of half extents ``half`` placed by ``code`` relative to ``ref`` (7,), its bottom at ``base`` (m)."""
-    x, y, yaw = relpos.decode(ref, half, code)
+def placed(ref: np.ndarray, half: np.ndarray, code: np.ndarray, base: float, snap: bool = False) -> np.ndarray:
+    """``(7,)`` box of half extents ``half`` placed by ``code`` relative to ``ref`` (7,), its bottom at ``base`` (m);
+    ``snap``: the code's bits win over its reals (:func:`.relpos.decode`)."""
+    x, y, yaw = relpos.decode(ref, half, code, snap)
     return np.array([x, y, base + half[2], half[0], half[1], half[2], yaw])
 
 
-def place(node: Node, box: np.ndarray, out: list[tuple[str, str | None, np.ndarray]]) -> None:
+def place(node: Node, box: np.ndarray, out: list[tuple[str, str | None, np.ndarray]], snap: bool = False) -> None:
     """Append ``(label, object_id, box)`` of every leaf under ``node``, its anchor at ``box`` (7,), depth first."""
     if node.kind == "leaf":
         out.append((node.label, node.object_id, box))
@@ -272,17 +273,19 @@ def place(node: Node, box: np.ndarray, out: list[tuple[str, str | None, np.ndarr
     boxes = [box]
     for k, child in enumerate(node.children[1:]):
         base = box[2] + box[5] if node.kind == "support" else box[2] - box[5]
-        boxes.append(placed(box, anchor(child).half, node.codes[k], base))
+        boxes.append(placed(box, anchor(child).half, node.codes[k], base, snap))
     for child, b in zip(node.children, boxes):
-        place(child, b, out)
+        place(child, b, out, snap)
 
 
-def layout(tree: Node, rect: tuple[float, float, float, float]) -> list[tuple[str, str | None, np.ndarray]]:
+def layout(tree: Node, rect: tuple[float, float, float, float],
+           snap: bool = False) -> list[tuple[str, str | None, np.ndarray]]:
     """(label, object_id, box (7,)) per leaf, depth first, placed top down from the codes onto ``rect``.
 
     ``rect = (xmin, ymin, xmax, ymax)`` (m): wall ``k`` of the tree goes onto wall ``k`` of ``rect`` (its box as
     :func:`rectangle_walls` would give, with the tree's wall thickness and height), which is how a decoded tree
     is re-anchored onto a held-out room. Floor objects get ``cz = hz``, supported ones their parent's top + hz.
+    ``snap``: every code's bits win over its reals (decoded trees, :func:`.relpos.decode`).
     """
     height = 2 * float(tree.half[2]) if tree.half is not None else DEFAULT_HEIGHT
     out: list[tuple[str, str | None, np.ndarray]] = []
@@ -290,7 +293,7 @@ def layout(tree: Node, rect: tuple[float, float, float, float]) -> list[tuple[st
         thick = 2 * float(wall.half[1]) if wall.half is not None else DEFAULT_THICKNESS
         box = rect_wall(rect, k, thick, height)
         if wall.children:
-            place(wall.children[0], placed(box, anchor(wall.children[0]).half, wall.codes[0], 0.0), out)
+            place(wall.children[0], placed(box, anchor(wall.children[0]).half, wall.codes[0], 0.0, snap), out, snap)
     return out
 
 

@@ -42,10 +42,11 @@ def supports(tree: Node) -> dict[int, int]:
     return {order[c]: order[p] for c, p in out.items() if c in order and p in order}
 
 
-def furnish(tree: Node, room, pool: ModelPool, prefix: str):
+def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False):
     """The room (its architecture) with the tree's leaves laid onto its bounding rectangle, and each object's
-    support parent id; leaves whose label has no training instance are left out."""
-    placed = layout(tree, room_rect(room))
+    support parent id; leaves whose label has no training instance are left out. ``snap``: the codes' bits win
+    over their reals (:func:`.relpos.decode`)."""
+    placed = layout(tree, room_rect(room), snap)
     on = supports(tree)
     out, ids, parents = with_objects(room, []), {}, {}
     for k, (label, _, box) in enumerate(placed):
@@ -69,7 +70,7 @@ class GrainsLayout:
 
     def __init__(self, config: dict, name: str):
         self.config, self.name, self.cfg = config, name, config["grains"]
-        self.info = {"max_depth": self.cfg["max_depth"], "rooms": self.rooms_info}
+        self.info = {"max_depth": self.cfg["max_depth"], "snap": self.cfg["snap"], "rooms": self.rooms_info}
 
     def room_for(self, tree: Node, k: int, scene_id: str, corpus) -> RoomInput:
         """The architecture scene ``k`` is laid onto: the held-out rooms in turn."""
@@ -96,7 +97,7 @@ class GrainsLayout:
             start = time.perf_counter()
             sid = f"gen_{task.corpus.room_type}_{i:05d}"
             room = self.room_for(tree, i, sid, task.corpus)
-            placed, parents = furnish(tree, room, ctx.pool, sid)
+            placed, parents = furnish(tree, room, ctx.pool, sid, self.cfg["snap"])
             record = {"seconds": decode_s + time.perf_counter() - start, "planned_objects": len(leaves(tree))}
             yield Scene(sid, None if own else room.room_id, placed, walls_of(placed), record=record,
                         parents=parents, own_architecture=own)

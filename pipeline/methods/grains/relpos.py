@@ -114,18 +114,39 @@ def edge_pair(code: np.ndarray, edges: tuple[int, int]) -> tuple[int, int]:
     return cands[int(np.argmax(scores))]
 
 
-def decode(a: np.ndarray, half_b: np.ndarray, code: np.ndarray) -> tuple[float, float, float]:
+def snapped(code: np.ndarray, d: np.ndarray, ext: np.ndarray, half_a: np.ndarray, half_b: np.ndarray) -> np.ndarray:
+    """``b``'s centre ``d`` (2,) in ``a``'s frame moved onto what the code's bits state (bits > 0.5): centres
+    aligned, fronts or backs collinear (with the same yaw), then a contact with one side of ``a`` (the bound's
+    edge on that side's line, outside it), which wins on its axis. ``ext``: the bound's half sizes (m)."""
+    al, at = np.asarray(code[ALIGN]) > 0.5, np.asarray(code[ATTACH]) > 0.5
+    d = np.array(d, float)
+    d[0] = 0.0 if al[0] else d[0]
+    d[1] = 0.0 if al[1] else d[1]
+    if al[2] and al[3] != al[4]:
+        d[1] = (half_a[1] - half_b[1]) if al[3] else (half_b[1] - half_a[1])
+    if at[0] != at[1]:
+        d[1] = (half_a[1] + ext[1]) * (1.0 if at[0] else -1.0)
+    if at[2] != at[3]:
+        d[0] = (half_a[0] + ext[0]) * (-1.0 if at[2] else 1.0)
+    return d
+
+
+def decode(a: np.ndarray, half_b: np.ndarray, code: np.ndarray, snap: bool = False) -> tuple[float, float, float]:
     """b's centre x, y and yaw given a (7,), b's half extents (3,) and a code (28,) (a decoded code may be soft:
     use argmax of each one-hot group: the x pair among its four entries, the y pair among its four).
 
+    ``snap``: a decoded code's reals are regressed, its bits classified; with ``snap`` the bits win (the same-yaw
+    bit sets the rotation to 0, then :func:`snapped`), as the bits exist to state exact contacts and alignments.
     The yaw comes back wrapped into ``[-pi, pi)``; metres and radians.
     """
     a, code = np.asarray(a, float), np.asarray(code, float)
-    rot = float(code[ROT]) * math.pi
+    rot = 0.0 if snap and code[ALIGN.start + 2] > 0.5 else float(code[ROT]) * math.pi
     ext = extents(rot, half_b)
     ax, bx = edge_pair(code, X_EDGES)
     ay, by = edge_pair(code, Y_EDGES)
     dx = _SIGN[ax] * a[3] + code[OFF_X] - _SIGN[bx] * ext[0]
     dy = _SIGN[ay] * a[4] + code[OFF_Y] - _SIGN[by] * ext[1]
+    if snap:
+        dx, dy = snapped(code, np.array([dx, dy]), ext, a[3:5], np.asarray(half_b, float))
     c = a[:2] + rotation(float(a[6])) @ np.array([dx, dy])
     return float(c[0]), float(c[1]), wrap(float(a[6]) + rot)
