@@ -56,7 +56,6 @@ class Rows:
                                                   room.poses)]
         return record
 
-
     def _add_own_architecture(self, scene: Scene, corpus: Corpus) -> None:
         """The rooms row and wall rows of a scene whose method decoded its own walls (``scene.room``'s outline)."""
         room = scene.room

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...geometry.boxes import footprint_corners, to_local
+from ...geometry.polygon import polygon_segments
 from ...room import RoomInput
 from . import relpos
 
@@ -307,7 +308,7 @@ def decoded_room(tree: Node, room_id: str, room_type: str) -> RoomInput:
     thick = [2 * float(w.half[1]) for w in tree.children[:4] if w.half is not None]
     return RoomInput(room_id=room_id, room_type=room_type, height=2 * float(hz), outline=outline,
                      wall_ids=[f"wall_{k}" for k in range(4)],
-                     wall_segments=np.stack([outline, np.roll(outline, -1, axis=0)], 1),
+                     wall_segments=polygon_segments(outline),
                      wall_thickness=np.full(4, float(np.median(thick)) if thick else DEFAULT_THICKNESS),
                      openings=[], object_ids=[], categories=[], model_ids=[], boxes=np.zeros((0, 7)),
                      poses=np.zeros((0, 7)))

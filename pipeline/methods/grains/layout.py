@@ -72,9 +72,8 @@ class GrainsLayout:
         self.config, self.name, self.cfg = config, name, config["grains"]
         self.info = {"max_depth": self.cfg["max_depth"], "snap": self.cfg["snap"], "rooms": self.rooms_info}
 
-    def room_for(self, tree: Node, k: int, scene_id: str, corpus) -> RoomInput:
-        """The architecture scene ``k`` is laid onto: the held-out rooms in turn."""
-        rooms = corpus.heldout()
+    def room_for(self, tree: Node, k: int, scene_id: str, rooms: list[RoomInput]) -> RoomInput:
+        """The architecture scene ``k`` is laid onto: the held-out ``rooms`` in turn."""
         return rooms[k % len(rooms)]
 
     def generate(self, task: Task) -> Iterator[Scene]:
@@ -84,21 +83,21 @@ class GrainsLayout:
         model.load_state_dict(saved.state["model"])
         model.eval()
         ctx = load_context(self.config, task.corpus)
-        count = task.count or self.cfg["scenes"]
-        if not task.corpus.heldout():
+        rooms, count = task.corpus.heldout(), task.count or self.cfg["scenes"]
+        if not rooms:
             return
         # one seed for both modes: grains and grains_decoded furnish the same trees, in different rooms
         gen = torch.Generator().manual_seed(zlib.crc32(f"{self.config['seed']}/grains".encode()))
         start = time.perf_counter()
         trees = model.decode(torch.randn(count, model.sizes.root_feature, generator=gen), self.cfg["max_depth"])
         decode_s = (time.perf_counter() - start) / count  # decoded in one batch: each scene's share
-        own = self.own_architecture
         for i, tree in enumerate(progress(trees, total=count, desc=f"{self.name} {task.corpus.room_type}")):
             start = time.perf_counter()
             sid = f"gen_{task.corpus.room_type}_{i:05d}"
-            room = self.room_for(tree, i, sid, task.corpus)
+            room = self.room_for(tree, i, sid, rooms)
             placed, parents = furnish(tree, room, ctx.pool, sid, self.cfg["snap"])
             record = {"seconds": decode_s + time.perf_counter() - start, "planned_objects": len(leaves(tree))}
+            own = self.own_architecture
             yield Scene(sid, None if own else room.room_id, placed, walls_of(placed), record=record,
                         parents=parents, own_architecture=own)
 
@@ -108,5 +107,6 @@ class GrainsDecoded(GrainsLayout):
     rooms_info = "the rooms the trees decode (own walls, no doors or windows)"
     own_architecture = True
 
-    def room_for(self, tree: Node, k: int, scene_id: str, corpus) -> RoomInput:
-        return decoded_room(tree, scene_id, corpus.room_type)
+    def room_for(self, tree: Node, k: int, scene_id: str, rooms: list[RoomInput]) -> RoomInput:
+        """The room ``tree`` decodes, of the held-out rooms' type."""
+        return decoded_room(tree, scene_id, rooms[0].room_type)

@@ -39,6 +39,7 @@ PAIRS = slice(3, 19)
 ATTACH = slice(19, 23)
 ALIGN = slice(23, 28)
 ALIGN_NAMES = ("centre_x", "centre_y", "yaw", "front", "back")
+SAME_YAW = ALIGN.start + ALIGN_NAMES.index("yaw")  # the same-yaw bit's index in a code
 YAW_TOL = math.radians(1.0)
 X_EDGES, Y_EDGES = (2, 3), (0, 1)  # SIDES indices of left/right and front/back
 _SIGN = {0: 1.0, 1: -1.0, 2: -1.0, 3: 1.0}  # the side's direction along its axis
@@ -140,7 +141,7 @@ def decode(a: np.ndarray, half_b: np.ndarray, code: np.ndarray, snap: bool = Fal
     The yaw comes back wrapped into ``[-pi, pi)``; metres and radians.
     """
     a, code = np.asarray(a, float), np.asarray(code, float)
-    rot = 0.0 if snap and code[ALIGN.start + 2] > 0.5 else float(code[ROT]) * math.pi
+    rot = 0.0 if snap and code[SAME_YAW] > 0.5 else float(code[ROT]) * math.pi
     ext = extents(rot, half_b)
     ax, bx = edge_pair(code, X_EDGES)
     ay, by = edge_pair(code, Y_EDGES)
