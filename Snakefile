@@ -18,6 +18,7 @@ include: "rules/refine.smk"
 include: "rules/graph_model.smk"
 include: "rules/instantiate.smk"
 include: "rules/evaluate.smk"
+include: "rules/export.smk"
 
 
 rule all:

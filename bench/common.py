@@ -27,7 +27,6 @@ def search_flags(ap: argparse.ArgumentParser) -> None:
     config's)."""
     ap.add_argument("--early-backtrack", action=argparse.BooleanOptionalAction)
     ap.add_argument("--restarts", type=int)
-    ap.add_argument("--pose-rules", action=argparse.BooleanOptionalAction)
     ap.add_argument("--keep-relations", action=argparse.BooleanOptionalAction)
     ap.add_argument("--relations-first", action=argparse.BooleanOptionalAction)
     ap.add_argument("--free-support", action=argparse.BooleanOptionalAction)
@@ -39,7 +38,6 @@ def search_overrides(args) -> dict:
     out = {k: v for k, v in (("early_backtrack", args.early_backtrack), ("restarts", args.restarts),
                              ("keep_relations", args.keep_relations), ("free_support", args.free_support))
            if v is not None}
-    out |= {} if args.pose_rules is None else {"pose_rules": {"enabled": args.pose_rules}}
     return out | ({} if args.relations_first is None else {"checks": {"relations_first": args.relations_first}})
 
 
@@ -47,7 +45,6 @@ def search_suffix(args) -> str:
     """The report name's suffix for the search flags given (none: the config's settings)."""
     return ({True: "_early_backtrack", False: "_no_early_backtrack", None: ""}[args.early_backtrack]
             + (f"_restarts{args.restarts}" if args.restarts is not None else "")
-            + {True: "_pose_rules", False: "_no_pose_rules", None: ""}[args.pose_rules]
             + {True: "_keep_relations", False: "_no_keep_relations", None: ""}[args.keep_relations]
             + {True: "_relations_first", False: "_collisions_first", None: ""}[args.relations_first]
             + {True: "_free_support", False: "_no_free_support", None: ""}[args.free_support])

@@ -202,5 +202,22 @@ def view(path: Optional[Path] = typer.Argument(None, help="a generated method's 
         serve_page(target, host, port, typer.echo)
 
 
+@app.command("export")
+def export(fmt: str = typer.Argument(..., metavar="FORMAT", help="usd | procthor | front3d"),
+           path: Path = typer.Argument(..., metavar="PATH", help="a generated set (results/generated/<type>/<method>) or a corpus's "
+                                                 "shards (results/ingest/shards)"),
+           out: Optional[Path] = typer.Option(None, "--out", help="the folder to write (default PATH/export/FORMAT)"),
+           config: Optional[Path] = ConfigOpt) -> None:
+    """Write every room of a generated set or a corpus in FORMAT (docs/formats.md) and print where."""
+    from .export import export_folder
+
+    cfg = _guard(config_mod.load, config) if config else config_mod.validate({})
+    folder, summary = _guard(export_folder, fmt, path, out, {**cfg["export"], "ithor": cfg["ithor"]})
+    missing, skipped = summary.get("unmapped") or {}, summary["skipped"]
+    typer.echo(f"wrote {summary['rooms']} rooms ({summary['objects']} objects) as {fmt} to {folder}" + (
+        f"; left out {sum(missing.values())} objects with no AI2-THOR asset: {', '.join(missing)}" if missing else "") + (
+        f"; skipped {len(skipped)} rooms whose walls form no closed loop (export.json names them)" if skipped else ""))
+
+
 if __name__ == "__main__":  # pragma: no cover
     app()

@@ -228,6 +228,11 @@ SCHEMAS["scenes"] = pa.schema([
        "distant) and cause: 'relaxed' (accepted broken once the search's tolerance grew), 'lost_later' (held when its "
        "object was placed, broken by a later one), 'unplaced' (an end left out); and by what extraction finds instead: "
        "'distance' (same side, other distance), 'direction' (another side), 'absent' (no such edge)"),
+    _f("relaxed_objects", _I32, doc="objects the search kept with a broken planned relation (PlanIT's search and "
+       "its layout modes; null for the other methods)"),
+    _f("relaxed", _STR, doc="JSON: per object kept with a broken relation, its id, category, cost, the tolerance it "
+       "was kept at, its failures before, the check that refused it most ('cause') and each broken edge: source, "
+       "target, what was planned and what extraction found instead"),
     _f("unplanned_edges", _I32, doc="extracted support or spatial edges at an object that the plan lacks"),
     _f("unplanned_adjacent", _I32, doc="of those, support or adjacent ones"),
     _f("colliding_objects", _I32, doc="objects penetrating another deeper than instantiate.checks.collision"),

@@ -94,6 +94,7 @@ ROOM_TYPES = "results/graphs/ingested/room_types.csv"
 ROOM_TYPES_HTML = "results/graphs/ingested/room_types.html"
 RUNTIME = "results/runtime.csv"
 RUNTIME_HTML = "results/runtime.html"
+EXPORT = "results/export/{room_type}/{method}/{format}.zip"  # a method's rooms in one format (export.formats)
 METHODS = config["generation"]["methods"]
 VARIANTS = config["instantiate"]["variants"]
 ANNEALING = [m for m in METHODS if planit_methods.get(m).program is not None]  # methods with an energy trace
@@ -255,8 +256,9 @@ def spec_placement(wildcards):
 
 
 def get_ablation_model(wildcards):
-    """A Table 3 variant's placement networks: the FCN for the unconditional location, else the CFCN."""
-    net = "fcn" if VARIANTS[wildcards.variant]["location"] == "fcn" else "cfcn"
+    """A Table 3 variant's placement model: the unconditional networks, the prior, else the conditional networks."""
+    location = VARIANTS[wildcards.variant]["location"]
+    net = location if location in ("fcn", "prior") else "cfcn"
     return PLACEMENT.format(room_type=wildcards.room_type, net=net, name="model.pt")
 
 
@@ -282,4 +284,5 @@ def learned_outputs(wildcards):
         *expand(TABLE3, room_type=[t for t in config["instantiate"]["table3_room_types"] if t in types]),
         *expand(EVAL, room_type=types, name=["metrics.json", "gallery3d.html"]),
         *expand(EVAL, room_type=types, name=["energy_trace.png"] if ANNEALING else []),
+        *expand(EXPORT, room_type=types, method=METHODS, format=config["export"]["formats"]),
     ]

@@ -179,6 +179,7 @@ rule complete_room:
 rule table3:
     input:
         summaries=expand(ABLATION, variant=TABLE3_VARIANTS, name="summary.json", allow_missing=True),
+        nets=expand(PLACEMENT, net=["cfcn", "fcn"], name="training.json", allow_missing=True),
     output:
         table=TABLE3,
         table_html=report(TABLE3_HTML, caption="../report/table3.rst", category="4. Instantiation (Table 3)",

@@ -139,8 +139,8 @@ def test_a_set_with_no_rooms_scores_to_empty_rows_and_undefined_figures(learned)
     config = default_config()
     config["evaluate"]["functional"] = cfg
     index = {c: k for k, c in enumerate(["bed", "chair", "desk", "nightstand"])}
-    empty = room_rows(RoomSet("none", [], []), checks, index, {}, set(), np.zeros((0, 64, 64), np.int16), [], config)
-    real = room_rows(RoomSet("real", [bedroom()], [[None] * 5]), checks, index, {}, set(),
+    empty = room_rows(RoomSet("none", [], []), checks, index, ({}, set(), {}), np.zeros((0, 64, 64), np.int16), [], config)
+    real = room_rows(RoomSet("real", [bedroom()], [[None] * 5]), checks, index, ({}, set(), {}),
                      np.zeros((0, 64, 64), np.int16), [], config)
     assert len(empty) == 0 and set(tables.SCHEMAS["eval_scenes"].names) <= set(empty.columns)
     names = [functional.check_name(c) for c in checks["checks"]]

@@ -57,6 +57,7 @@ def bedroom_plan() -> ScenePlan:
                      [1, 1, 1, 2, 2], [None, None, None, "ns_l", "ns_r"], ["hub", "spoke", "spoke", "none", "none"], edges)
 
 
+EXTRACT = default_config()["extract"]
 AREAS = {"bed": 3.2, "nightstand": 0.2, "table_lamp": 0.04, "wardrobe": 0.6, "desk": 0.72}
 
 
@@ -66,7 +67,7 @@ def test_hand_built_bedroom_is_placed_and_its_extracted_graph_holds_every_planne
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
     assert [plan.ids[k] for k in seq][:3] == ["bed", "ns_l", "ns_r"]  # the hub, then its spokes; supported last
-    out = instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), pool, checker, ic, seed)
+    out = instantiate(plan, room, walls, seq, Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, seed)
     assert out.ok, out.reason
     assert sorted(out.room.object_ids) == sorted(plan.ids)
     m = scene_metrics.consistency(plan, out.room, walls.ids, checker)  # a fresh extraction of the finished room
@@ -80,7 +81,7 @@ def test_same_seed_same_room():
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
-    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), pool, checker, ic, 5) for _ in range(2))
+    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 5) for _ in range(2))
     assert np.array_equal(a.room.boxes, b.room.boxes)
 
 
@@ -88,7 +89,7 @@ class PlantedCorner:
     """Rule bands, except the wardrobe's first proposal: the bottom-right corner, where nothing fits on its right."""
 
     def __init__(self):
-        self.rules, self.first = RelationPrior(), True
+        self.rules, self.first = RelationPrior(EXTRACT), True
 
     def density(self, room, walls, category, anchors, points):
         if category == "wardrobe" and self.first:
@@ -123,12 +124,12 @@ def _unsatisfiable():
 
 def test_an_unsatisfiable_graph_ends_with_a_failure_record_not_a_hang():
     room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=6, restarts=2)
-    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
     assert not out.ok and "backtrack budget (6) spent: no place for b (bed)" in out.reason
     assert out.attempts == 3 and out.backtracks == 3 * 6  # every restart spent its own budget; the counts add up
     assert out.rejections > 0 and out.room.object_ids == []
     assert set(out.failures) == {"outside"}
-    once = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker,
+    once = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker,
                        {**ic, "restarts": 0}, 0)
     assert once.attempts == 1 and once.backtracks == 6 and 0 < once.rejections < out.rejections
 
@@ -155,7 +156,7 @@ def test_restarts_leave_a_scene_placed_at_the_first_attempt_unchanged():
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
-    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(), FaceAway()), pool, checker,
+    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker,
                         {**ic, "restarts": n}, 1) for n in (0, 3))
     assert a.ok and b.ok and a.attempts == b.attempts == 1
     assert np.array_equal(a.room.boxes, b.room.boxes) and a.rejections == b.rejections
@@ -171,7 +172,7 @@ def test_an_object_with_no_place_fails_the_scene_or_is_dropped_with_what_it_supp
                      ["left-right", "left-right", "radial"], [1, 1, 2], [None, None, "b"], ["none"] * 3,
                      [PlanEdge("wall_0", "b", "spatial", "front", "adjacent"),
                       PlanEdge("wall_0", "n", "spatial", "front", "adjacent"), PlanEdge("b", "l", "support", None, None)])
-    out = instantiate(plan, room, walls, [0, 1, 2], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(plan, room, walls, [0, 1, 2], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
     if mode == "fail":
         assert out.status == "failed" and "no place for b (bed)" in out.reason and out.room.object_ids == []
     else:
@@ -193,7 +194,7 @@ def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_c
     room, walls, pool, checker, ic = setup(["nightstand"], NARROW, on_exhausted=mode)
     plan = ScenePlan("s4", "r0", "bedroom", ["n", "v"], ["nightstand", "vacuum_cleaner"], ["left-right", "none"],
                      [1, 1], [None, None], ["none"] * 2, [PlanEdge("wall_0", "n", "spatial", "front", "adjacent")])
-    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
     if mode == "fail":
         assert out.status == "failed" and out.reason == "no training instance of category 'vacuum_cleaner' for v"
         assert out.room.object_ids == []  # failed before placing the nightstand
@@ -205,7 +206,7 @@ def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_c
 
 def test_the_time_budget_ends_a_scene_with_its_reason():
     room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, time_budget=0.3)
-    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
     assert not out.ok and out.reason.startswith("time budget (0.3 s) spent")
 
 
@@ -213,7 +214,7 @@ def test_the_candidate_budget_ends_a_scene_the_same_way_on_any_machine():
     """Work, not seconds: the search stops after exactly ``candidate_budget`` candidates, with its reason, whatever
     the load (the time budget, far above, is not reached)."""
     room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, candidate_budget=40, restarts=2)
-    runs = [instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 0)
+    runs = [instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
             for _ in range(2)]
     for out in runs:
         assert not out.ok and out.reason == "candidate budget (40) spent at object 1 of 1"
@@ -227,7 +228,7 @@ def test_an_l_shaped_room_keeps_furniture_inside_its_outline():
     plan = ScenePlan("s3", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1], [None, None],
                      ["none", "none"], [PlanEdge(walls.ids[2], "w", "spatial", "front", "adjacent"),
                                         PlanEdge(walls.ids[3], "d", "spatial", "front", "adjacent")])
-    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(), FaceAway()), pool, checker, ic, 3)
+    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 3)
     assert out.ok, out.reason
     corners = footprint_corners(*out.room.boxes[:, [0, 1, 3, 4, 6]].T)
     assert (outside_area(np.array(outline, float), corners, ic["checks"]["outside"]) <= 1e-4).all()
@@ -261,7 +262,7 @@ def test_frames_round_trip_and_rename_sides():
 def test_the_glb_reloads_with_one_node_per_object_wall_and_the_floor(tmp_path):
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
+    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
                       pool, checker, ic, 0)
     scene = export.room_scene(out.room, walls, checker.meshes.get)
     raw = export.glb(out.room, walls, checker.meshes.get)  # the bytes scenes.zip holds
@@ -426,11 +427,12 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
     from pipeline.learning.checkpoint import Checkpoint
     from pipeline.methods.planit.nets.proposer import NetProposer
     from pipeline.methods.planit.nets.train import build
-    from pipeline.placement.search import Grid, anchors_of
+    from pipeline.placement.anchors import anchors_of
+    from pipeline.placement.proposers import Grid
 
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
+    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
                       pool, checker, ic, 0)
     bed_only = with_objects(out.room, [out.room.object_ids.index("bed")])
     preset = default_config()["placement"]["presets"]["tiny"]
@@ -457,13 +459,14 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
 
 def _desk_right_of_a_wardrobe_flush_with_the_wall(early: bool):
     """A given wardrobe whose right side touches the right wall, and a desk planned adjacent to that side."""
-    room, walls, pool, checker, ic = setup(["wardrobe", "desk"], max_backtracks=8, early_backtrack=early, restarts=0)
+    room, walls, pool, checker, ic = setup(["wardrobe", "desk"], max_backtracks=8, early_backtrack=early, restarts=0,
+                                           per_object=False)  # PlanIT's scene-wide tolerance: 0 for 2 of 8 backtracks
     inst = pool.pick("wardrobe", "left-right", np.random.default_rng(0))
     box, pose = place(inst, 4.0 - inst.half[0], 1.75, None, 0.0)  # yaw 0: its right side faces +x, on the wall
     room = add_object(room, "w", "wardrobe", inst.model_id, box, pose)
     plan = ScenePlan("s3", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1],
                      [None, None], ["none", "none"], [PlanEdge("w", "d", "spatial", "right", "adjacent")])
-    return instantiate(plan, room, walls, [1], Combined(RelationPrior(soft=1e-3), FaceAway()), pool, checker, ic, 0)
+    return instantiate(plan, room, walls, [1], Combined(RelationPrior(EXTRACT, soft=1e-3), FaceAway()), pool, checker, ic, 0)
 
 
 def test_early_backtrack_skips_the_samples_of_an_object_no_band_leaves_a_cell_for():
@@ -476,7 +479,7 @@ def test_early_backtrack_skips_the_samples_of_an_object_no_band_leaves_a_cell_fo
 def test_early_backtrack_still_places_the_hand_built_bedroom_with_every_planned_edge():
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"], early_backtrack=True)
     plan = bedroom_plan()
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()),
+    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
                       pool, checker, ic, 0)
     assert out.ok, out.reason
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
@@ -491,7 +494,7 @@ def test_the_free_floor_kept_between_samples_follows_every_insertion_and_backtra
     l_room = ((0, 0), (4, 0), (4, 2), (2, 2), (2, 4), (0, 4))
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"], outline=l_room)
     plan = bedroom_plan()
-    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()), pool,
+    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()), pool,
                checker, ic, np.random.default_rng(0))
     half = np.array([0.25, 0.2])
     empty = s.free_floor(half)
@@ -517,16 +520,16 @@ def test_a_supported_object_is_offered_the_part_of_its_support_no_sibling_covers
 
     room, walls, pool, checker, ic = setup(["desk", "table_lamp"], free_support=free)
     plan = bedroom_plan()
-    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(), FaceAway()), pool,
+    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()), pool,
                checker, ic, np.random.default_rng(0))
     s.room = add_object(room, "desk", "desk", "m", np.array([2.0, 1.5, 0.375, 0.6, 0.3, 0.375, 0.0]),
                         np.array([2.0, 1.5, 0.0, 0.0, 1.0, 1.0, 1.0]))
     s.room = add_object(s.room, "lamp", "table_lamp", "m", np.array([1.6, 1.5, 0.95, 0.1, 0.1, 0.2, 0.0]),
                         np.array([1.6, 1.5, 0.75, 0.0, 1.0, 1.0, 1.0]))
-    cells, pts = s.free_top(0, (0.0, 0.0), np.array([0.15, 0.1])), s.grid.points
-    on_desk = (np.abs(pts[:, 0] - 2.0) <= 0.6) & (np.abs(pts[:, 1] - 1.5) <= 0.3)
+    cells, pts = s.free_top(0, np.array([0.15, 0.1])), s.grid.points
+    on_desk = (np.abs(pts[:, 0] - 2.0) <= 0.5) & (np.abs(pts[:, 1] - 1.5) <= 0.2)  # the top shrunk by 0.1 m, any turn
     under_lamp = (np.abs(pts[:, 0] - 1.6) <= 0.2) & (np.abs(pts[:, 1] - 1.5) <= 0.2)
-    assert on_desk.sum() > 100 and (under_lamp & on_desk).sum() > 20
+    assert on_desk.sum() > 60 and (under_lamp & on_desk).sum() > 10
     assert np.array_equal(cells, on_desk & ~under_lamp if free else on_desk)
-    lamp_top = (np.abs(pts[:, 0] - 1.6) <= 0.1) & (np.abs(pts[:, 1] - 1.5) <= 0.1)
-    assert np.array_equal(s.free_top(1, (0.0, 0.0), np.array([0.15, 0.1])), lamp_top)  # nothing stands on the lamp
+    lamp_top = (np.abs(pts[:, 0] - 1.6) <= 0.025) & (np.abs(pts[:, 1] - 1.5) <= 0.025)  # at least half a cell
+    assert np.array_equal(s.free_top(1, np.array([0.15, 0.1])), lamp_top)  # nothing stands on the lamp

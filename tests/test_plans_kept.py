@@ -17,7 +17,7 @@ from pipeline.geometry.frames import Frame
 from pipeline.geometry.function import sides
 from pipeline.methods.interface import Scene
 from pipeline.methods.scenes import Rows, drops, plan_loss
-from pipeline.placement import poses, scene_metrics
+from pipeline.placement import scene_metrics
 from pipeline.placement.plan import PlanEdge
 from pipeline.placement.search import Anchor
 from pipeline.room.contents import implausible, learn_contents
@@ -40,34 +40,6 @@ def test_sides_of_a_tucked_chair_a_flanking_nightstand_and_a_corner():
     assert {SIDES[s[bed, ns]], SIDES[s[bed, ns + 1]]} == {"left", "right"}
     corner = np.array([room.boxes[desk], [3.0, 1.0, 0.0, 0.1, 0.1, 0.1, 0.0]])  # beyond the desk's right-front corner
     assert s[bed, bed] == -1 and sides(corner)[0, 1] == -1
-
-
-@pytest.fixture(scope="module")
-def rules():
-    cfg = {**default_config()["instantiate"]["pose_rules"], "min_share": 0.85}
-    train = [bedroom(dx, room_id=f"t{k}") for k, dx in enumerate(np.linspace(-0.6, 0.6, 25))]
-    return poses.learn_pose_rules(train, cfg)
-
-
-def test_pose_rules_are_learned_from_the_training_rooms(rules):
-    assert rules.turns[("desk", "chair", SIDES.index("front"))] == 2  # faces its desk
-    assert rules.turns[("bed", "nightstand", SIDES.index("left"))] == 0  # turns with the bed
-    assert ("desk", "chair", SIDES.index("left")) not in rules.turns  # never seen there
-
-
-def test_a_chair_in_front_of_its_desk_is_turned_to_face_it_without_the_network(rules):
-    base = bedroom(chair_yaw=0.0)
-    desk = base.categories.index("desk")
-    for yaw in (0.0, np.pi / 2):  # the desk turned: the rule is in the desk's frame
-        boxes = base.boxes.copy()
-        boxes[desk, 6] = yaw
-        room = replace(base, boxes=boxes)
-        anchor = Anchor("desk", Frame(tuple(room.boxes[desk, :2]), yaw), "none", "front", "adjacent", obj=desk)
-        front = room.boxes[desk, :2] + 0.6 * np.array([-np.sin(yaw), np.cos(yaw)])
-        got = rules.yaw(room, "chair", [anchor], front)
-        assert np.cos(got - (yaw + np.pi)) == pytest.approx(1.0)
-        beside = room.boxes[desk, :2] + 1.0 * np.array([np.cos(yaw), np.sin(yaw)])
-        assert rules.yaw(room, "chair", [anchor], beside) is None  # no rule there: the network's turn
 
 
 def test_lost_plan_edges_are_classified_by_when_and_what_extraction_found():

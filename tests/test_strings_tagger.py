@@ -77,7 +77,7 @@ def test_an_edges_relative_pose_is_its_target_in_the_anchors_frame():
 def test_from_relative_inverts_relative_pose(ox, oy, yaw, scale, x, y, turn):
     frame = Frame((ox, oy), yaw)
     xy, world_yaw = poses.from_relative(frame, scale, np.array([x, y, turn]))
-    back = poses.relative_pose(frame, scale, np.array([*xy, 0.5, 0.3, 0.2, 0.1, world_yaw]))
+    back = poses.relative_pose(frame, scale, np.array([*xy[0], 0.5, 0.3, 0.2, 0.1, world_yaw[0]]))
     np.testing.assert_allclose(back[:2], [x, y], atol=1e-9)
     assert np.cos(back[2] - turn) == pytest.approx(1.0)
 

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .. import tables
+from ..geometry.function import off_axis
 from ..geometry.raycast import intersector_class
 from ..placement.checks import Checker
 from . import distributions, functional, intervals, power, render
@@ -19,7 +20,7 @@ from .scores import finite, floors, goals, label_maps, rule_satisfaction, scene_
 from .sets import REAL, RoomSet
 
 SETTINGS = ("render", "walk", "cooccurrence_min_share", "collision", "out_of_bounds", "sca", "kl_eps", "functional", "power", "bootstrap",
-            "bootstrap_min_rooms")
+            "bootstrap_min_rooms", "off_axis_angle", "off_axis_min_objects")
 EXTRA = ["consistency", "violation", "nn_similarity", "contents_excess", "contents_missing", "functional_all"]
 
 
@@ -30,10 +31,10 @@ def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: 
     ev = config["evaluate"]
     index = {c: k for k, c in enumerate(sorted({c for s in (train, real, *gen) for r in s.rooms for c in r.categories}))}
     train_maps = label_maps(train, index, ev["render"])
-    learned = functional.learn_checks(train.rooms, ev["functional"])
+    learned = functional.learn_checks(train.rooms, ev["functional"], symmetry)
     by_name = {rs.name: rs for rs in (*gen, real)}
-    rows = {name: room_rows(rs, learned, index, meshes, box_models, train_maps, [r.room_id for r in train.rooms],
-                            config) for name, rs in by_name.items()}
+    rows = {name: room_rows(rs, learned, index, (meshes, box_models, symmetry), train_maps,
+                            [r.room_id for r in train.rooms], config) for name, rs in by_name.items()}
     checks = [functional.check_name(c) for c in learned["checks"]]
     stat = lambda frame, ref: intervals.figures(frame, ref, ev["kl_eps"], EXTRA + checks)
     reps = intervals.bootstrap(rows, REAL, stat, ev["bootstrap"], config["seed"])
@@ -51,6 +52,10 @@ def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: 
                           intersector_class(config["extract"]["backend"]), {})
         for name, rs in by_name.items():
             sets[name]["rules"] = rule_satisfaction(rs, checker)
+    axis = {name: off_axis_shares(rs.rooms, symmetry, ev["off_axis_angle"]) for name, rs in {**by_name, "real_train": train}.items()}
+    for name in by_name:
+        sets[name]["off_axis_share"] = axis[name]["all"]
+        sets[name]["off_axis_gap"] = off_axis_gap(axis[name], axis["real_train"], ev["off_axis_min_objects"])
     fl = floors(train, real, len(gen[0].rooms), ev, config["seed"])
     metrics = {"room_type": room_type, "sets": sets, "floors": fl, "functional": learned, "checks": checks,
                "differences": {f"vs_{ref}": intervals.differences(reps, ref, {n: len(f) for n, f in rows.items()},
@@ -58,24 +63,47 @@ def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: 
                                for ref in (gen[0].name, REAL)},
                "power": check,
                "train_nn_similarity": train_similarity(train_maps, ev["similarity_sample"], config["seed"]),
-               "real_train_rooms": len(train.rooms), "settings": {k: ev[k] for k in SETTINGS},
+               "real_train_rooms": len(train.rooms), "settings": {k: ev[k] for k in SETTINGS}, "off_axis": axis,
                "categories": sorted(index)}
     metrics["goals"] = goals(metrics, gen[0].name, REAL)
     scenes = pd.concat([f[tables.SCHEMAS["eval_scenes"].names] for f in rows.values()], ignore_index=True)
     return finite(metrics), scenes
 
 
-def room_rows(rs: RoomSet, learned: dict, index: dict, meshes: dict, box_models: set, train_maps, train_ids: list[str],
+def room_rows(rs: RoomSet, learned: dict, index: dict, models: tuple, train_maps, train_ids: list[str],
               config: dict) -> pd.DataFrame:
-    """One row per room: the ``eval_scenes`` columns, each functional check's outcome and the category counts."""
+    """One row per room: the ``eval_scenes`` columns, each functional check's outcome and the category counts
+    (``models``: meshes, box-only models and the model -> symmetry table)."""
+    meshes, box_models, symmetry = models
     scored = pd.DataFrame(scene_rows(rs, meshes, box_models, train_maps, train_ids, index, config),
                           columns=[c for c in tables.SCHEMAS["eval_scenes"].names if c not in functional.ROOM_COLUMNS])
-    fn = pd.DataFrame([functional.score_room(r, learned, config["evaluate"]["functional"]) for r in rs.rooms],
+    fn = pd.DataFrame([functional.score_room(r, learned, config["evaluate"]["functional"], symmetry) for r in rs.rooms],
                       index=scored.index, columns=[*map(functional.check_name, learned["checks"]),
                                                    *functional.ROOM_COLUMNS], dtype=float)
     counts = pd.DataFrame([Counter(r.categories) for r in rs.rooms], index=scored.index,
                           columns=sorted(index)).fillna(0).add_prefix(intervals.CATEGORY)
     return pd.concat([scored, fn, counts], axis=1)
+
+
+def off_axis_shares(rooms: list, symmetry: dict, angle_deg: float) -> dict:
+    """Share of objects turned more than ``angle_deg`` off their nearest wall's axes: over every object of the rooms
+    (``all``) and per category (radially symmetric objects left out), with the objects counted (``counts``)."""
+    off, cats = [], []
+    for r in rooms:
+        off.append(off_axis(r.boxes, r.outline, np.radians(angle_deg), functional.kinds(r, symmetry)))
+        cats += list(r.categories)
+    flags = pd.Series(np.concatenate(off) if off else np.zeros(0), index=cats, dtype=float).dropna()
+    by = flags.groupby(level=0)
+    return {"all": float(flags.mean()) if len(flags) else None,
+            "categories": {c: round(float(v), 4) for c, v in by.mean().items()}, "counts": by.size().astype(int).to_dict()}
+
+
+def off_axis_gap(shares: dict, train: dict, least: int):
+    """The largest gap (share points) between a set's and the training rooms' off-axis shares over the categories
+    both hold at least ``least`` (non-radial) objects of; None where there is none."""
+    gaps = [abs(v - train["categories"][c]) for c, v in shares["categories"].items()
+            if c in train["categories"] and shares["counts"][c] >= least and train["counts"][c] >= least]
+    return round(float(max(gaps)), 4) if gaps else None
 
 
 def classifier_scores(config: dict, by_name: dict, train: RoomSet, real: RoomSet, index: dict,

@@ -45,10 +45,16 @@ def vocabulary(cfg: dict) -> list[Predicate]:
             if (r, g, f) != ("any", None, "any")]
 
 
-def predicate_masks(room: RoomInput, preds: list[Predicate], cfg: dict) -> np.ndarray:
-    """``(p, n, n)`` bool: predicate ``p`` holds for target ``j`` around anchor ``i`` (never ``i == j``)."""
+def kinds(room: RoomInput, symmetry: dict | None) -> list[str] | None:
+    """Each object's symmetry type from the model -> type table (None without one: literal fronts)."""
+    return None if symmetry is None else [symmetry.get(m, "none") for m in room.model_ids]
+
+
+def predicate_masks(room: RoomInput, preds: list[Predicate], cfg: dict, symmetry: dict | None = None) -> np.ndarray:
+    """``(p, n, n)`` bool: predicate ``p`` holds for target ``j`` around anchor ``i`` (never ``i == j``); facing
+    counts a symmetric target's equivalent fronts (``symmetry``: model id -> type)."""
     n = len(room.object_ids)
-    region, gap, angle = regions(room.boxes), plan_gaps(room.boxes), facing_angles(room.boxes)
+    region, gap, angle = regions(room.boxes), plan_gaps(room.boxes), facing_angles(room.boxes, kinds(room, symmetry))
     lim = np.radians(cfg["facing_angle"])
     facing = {"any": np.ones((n, n), bool), "faces": angle <= lim, "away": angle >= np.pi - lim}
     out = np.empty((len(preds), n, n), bool)
@@ -70,13 +76,13 @@ def pair_outcomes(room: RoomInput, masks: np.ndarray, anchor: str, target: str) 
     return masks[:, a][:, :, t].any(axis=1).all(axis=1)
 
 
-def learn_pair_checks(rooms: list[RoomInput], cfg: dict) -> list[dict]:
+def learn_pair_checks(rooms: list[RoomInput], cfg: dict, symmetry: dict | None = None) -> list[dict]:
     """The confident (anchor, target, predicate) checks of the training rooms: per category pair the most specific
     confident predicate (ties: the higher training share), the pairs held by the most rooms first."""
     preds = vocabulary(cfg)
     tally: dict[tuple[str, str], list] = {}
     for room in rooms:
-        masks = predicate_masks(room, preds, cfg)
+        masks = predicate_masks(room, preds, cfg, symmetry)
         for a, t in product(sorted(set(room.categories)), repeat=2):
             outcome = pair_outcomes(room, masks, a, t)
             if outcome is not None:
@@ -96,29 +102,32 @@ def learn_pair_checks(rooms: list[RoomInput], cfg: dict) -> list[dict]:
     return checks[:cfg["max_checks"]]
 
 
-def wall_outcome(room: RoomInput, category: str, cfg: dict) -> bool | None:
-    """Every object of ``category`` stands with its back to a wall (None: the room has none)."""
+def wall_outcome(room: RoomInput, category: str, cfg: dict, symmetry: dict | None = None) -> bool | None:
+    """Every object of ``category`` stands with its back (a symmetric object: any equivalent back) to a wall (None:
+    the room has none)."""
     k = [i for i, c in enumerate(room.categories) if c == category]
     if not k:
         return None
-    return bool(back_to_wall(room.boxes[k], room.outline, cfg["wall"]["max_gap"],
-                             np.radians(cfg["wall"]["max_angle"])).all())
+    sym = kinds(room, symmetry)
+    return bool(back_to_wall(room.boxes[k], room.outline, cfg["wall"]["max_gap"], np.radians(cfg["wall"]["max_angle"]),
+                             None if sym is None else [sym[i] for i in k]).all())
 
 
-def learn_wall_checks(rooms: list[RoomInput], cfg: dict) -> list[dict]:
+def learn_wall_checks(rooms: list[RoomInput], cfg: dict, symmetry: dict | None = None) -> list[dict]:
     """The categories whose objects the training rooms confidently stand with their backs to a wall."""
     out = []
     for cat in sorted({c for r in rooms for c in r.categories}):
-        seen = [o for o in (wall_outcome(r, cat, cfg) for r in rooms) if o is not None]
+        seen = [o for o in (wall_outcome(r, cat, cfg, symmetry) for r in rooms) if o is not None]
         if len(seen) >= cfg["min_rooms"] and wilson_lower(sum(seen), len(seen)) >= cfg["min_share"]:
             out.append({"kind": "wall", "target": cat, "train_rooms": len(seen),
                         "train_share": round(sum(seen) / len(seen), 4)})
     return out
 
 
-def learn_checks(rooms: list[RoomInput], cfg: dict) -> dict:
-    """Everything the functional checks learn from the training rooms (JSON-ready)."""
-    return {"checks": learn_pair_checks(rooms, cfg) + learn_wall_checks(rooms, cfg),
+def learn_checks(rooms: list[RoomInput], cfg: dict, symmetry: dict | None = None) -> dict:
+    """Everything the functional checks learn from the training rooms (JSON-ready; ``symmetry``: model id -> type,
+    so that facing and back-to-wall count a symmetric object's equivalent fronts)."""
+    return {"checks": learn_pair_checks(rooms, cfg, symmetry) + learn_wall_checks(rooms, cfg, symmetry),
             "contents": learn_contents((r.categories for r in rooms), cfg["min_share"]), "training_rooms": len(rooms)}
 
 
@@ -127,18 +136,18 @@ def check_name(check: dict) -> str:
     return f"fn:{check['target']}@{check.get('anchor', 'wall')}"
 
 
-def score_room(room: RoomInput, learned: dict, cfg: dict) -> dict:
+def score_room(room: RoomInput, learned: dict, cfg: dict, symmetry: dict | None = None) -> dict:
     """One room's outcome per check (1.0 pass, 0.0 fail, NaN where the room lacks its categories), its contents
     (``contents_excess``, ``contents_missing``) and ``functional_all`` (1.0: every applicable check passes)."""
     row = {}
     pair = [c for c in learned["checks"] if c["kind"] == "pair"]
     preds = [Predicate(c["region"], c["gap"], c["facing"]) for c in pair]
-    masks = predicate_masks(room, preds, cfg) if pair else None
+    masks = predicate_masks(room, preds, cfg, symmetry) if pair else None
     for k, c in enumerate(pair):
         o = pair_outcomes(room, masks[k:k + 1], c["anchor"], c["target"])
         row[check_name(c)] = np.nan if o is None else float(o[0])
     for c in (c for c in learned["checks"] if c["kind"] == "wall"):
-        o = wall_outcome(room, c["target"], cfg)
+        o = wall_outcome(room, c["target"], cfg, symmetry)
         row[check_name(c)] = np.nan if o is None else float(o)
     outcomes = [v for v in row.values() if v == v]
     excess, missing = implausible(room.categories, learned["contents"])

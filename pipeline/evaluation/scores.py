@@ -58,9 +58,11 @@ def rule_satisfaction(rs: RoomSet, checker) -> dict:
 def set_counts(rows: pd.DataFrame, rs: RoomSet) -> dict:
     """How many rooms a set scores, how many its method attempted and how many of them are partial."""
     seconds = None if rs.scenes is None or rs.scenes["seconds"].isna().all() else float(rs.scenes["seconds"].median())
+    relaxed = None if rs.scenes is None or rs.scenes["relaxed_objects"].isna().all() else float(
+        rs.scenes["relaxed_objects"].fillna(0).sum() / max(rs.scenes["placed_objects"].sum(), 1))
     return {"scenes": len(rows), "attempted": rs.attempted,
             "partial": 0 if rs.scenes is None else int((rs.scenes["status"].astype(str) == "partial").sum()),
-            "seconds_per_scene": seconds}
+            "seconds_per_scene": seconds, "relaxed_share": relaxed}
 
 
 def floors(train: RoomSet, real: RoomSet, generated: int, cfg: dict, seed: int) -> dict:
@@ -131,8 +133,9 @@ def label_maps(rs: RoomSet, index: dict, cfg: dict) -> np.ndarray:
 
 
 TABLE_COLUMNS = ["scenes", "attempted", "category_kl", "count_distance", "object_collision_rate", "scene_collision_rate",
-                 "out_of_bounds_rate", "walkable_share", "reachable_scenes", "consistency", "violation", "nn_similarity",
-                 "contents_excess", "contents_missing", "functional_all", "cooccurrence_similarity", "seconds_per_scene"]
+                 "out_of_bounds_rate", "walkable_share", "reachable_scenes", "consistency", "violation", "relaxed_share",
+                 "nn_similarity", "contents_excess", "contents_missing", "functional_all", "cooccurrence_similarity",
+                 "off_axis_share", "off_axis_gap", "seconds_per_scene"]
 
 
 def metrics_table(metrics: dict) -> pd.DataFrame:

@@ -13,6 +13,25 @@ import numpy as np
 from .boxes import SIDES
 
 RADIAL_FRAMES = 8  # radial symmetry: this many turns stand for the continuum
+# turns under which an object of a symmetry type looks the same from above (its fronts); radial: every turn (0)
+FOLD = {"rotational-2": 2, "front-back": 2, "rotational-4": 4, "radial": 0}
+
+
+def wrap(angle):
+    """Angles (rad) wrapped to [-pi, pi)."""
+    return (np.asarray(angle, float) + np.pi) % (2 * np.pi) - np.pi
+
+
+def turn_error(angle, symmetry="none"):
+    """``(...)`` smallest turn (rad, 0..pi) from ``angle`` to a turn an object of ``symmetry`` cannot be told apart
+    from (0 for radial): how far a yaw difference, or a front's angle to a direction, is from none, counting the
+    equivalent fronts of symmetric objects (a rotational-2 keyboard turned by half a turn faces the same way).
+    ``symmetry`` is one type or an array of types broadcast against ``angle``."""
+    a = np.asarray(angle, float)
+    fold = np.vectorize(lambda s: FOLD.get(s, 1), otypes=[int])(np.asarray(symmetry, object))
+    step = 2 * np.pi / np.maximum(fold, 1)
+    err = np.abs(wrap(a - np.round(a / step) * step))
+    return np.where(fold == 0, 0.0, err)
 
 
 @dataclass(frozen=True)
@@ -45,13 +64,12 @@ def to_world(frame: Frame, points: np.ndarray) -> np.ndarray:
 def yaw_to_local(frame: Frame, yaw) -> np.ndarray:
     """World yaw -> frame yaw (a mirror reverses the turning sense), wrapped to [-pi, pi)."""
     y = np.asarray(yaw, float) - frame.yaw
-    y = -y if frame.mirror else y
-    return (y + np.pi) % (2 * np.pi) - np.pi
+    return wrap(-y if frame.mirror else y)
 
 
 def yaw_to_world(frame: Frame, yaw) -> np.ndarray:
     y = np.asarray(yaw, float)
-    return ((-y if frame.mirror else y) + frame.yaw + np.pi) % (2 * np.pi) - np.pi
+    return wrap((-y if frame.mirror else y) + frame.yaw)
 
 
 def boxes_to_local(frame: Frame, boxes: np.ndarray) -> np.ndarray:

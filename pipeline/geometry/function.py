@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .boxes import footprint_corners, footprint_overlap, rotation
+from .frames import FOLD, turn_error, wrap
 from .polygon import inward_normals, make_ccw, polygon_segments
 
 REGIONS = ("front", "back", "side_front", "side_back", "corner", "over")
@@ -66,9 +67,11 @@ def plan_gaps(boxes: np.ndarray) -> np.ndarray:
     return gap
 
 
-def facing_angles(boxes: np.ndarray) -> np.ndarray:
+def facing_angles(boxes: np.ndarray, symmetry=None) -> np.ndarray:
     """``(n, n)`` angle (rad, 0..pi) between target ``j``'s front and the direction from its centre to anchor
-    ``i``'s footprint (its nearest point; its centre where ``j``'s centre lies inside it). Row: anchor."""
+    ``i``'s footprint (its nearest point; its centre where ``j``'s centre lies inside it). Row: anchor. With
+    ``symmetry (n,)`` (each object's type), a symmetric target's nearest equivalent front counts
+    (:func:`~pipeline.geometry.frames.turn_error`)."""
     b = np.asarray(boxes, float).reshape(-1, 7)
     local = np.einsum("aji,atj->ati", rotation(b[:, 6]), b[None, :, :2] - b[:, None, :2])  # target in anchor frame
     half = b[:, None, 3:5]
@@ -77,22 +80,44 @@ def facing_angles(boxes: np.ndarray) -> np.ndarray:
     near = np.where(inside[..., None], 0.0, near)
     to_anchor = np.einsum("aij,atj->ati", rotation(b[:, 6]), near - local)  # world direction target -> anchor
     front = np.stack([-np.sin(b[:, 6]), np.cos(b[:, 6])], -1)[None]  # (1, target, 2)
-    cos = np.einsum("atj,atj->at", to_anchor, front) / np.maximum(np.linalg.norm(to_anchor, axis=-1), 1e-12)
-    return np.arccos(np.clip(cos, -1.0, 1.0))
+    cross = front[..., 0] * to_anchor[..., 1] - front[..., 1] * to_anchor[..., 0]
+    angle = np.arctan2(cross, np.einsum("atj,atj->at", to_anchor, front))
+    return turn_error(angle, "none" if symmetry is None else np.asarray(symmetry, object)[None, :])
 
 
-def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_angle: float) -> np.ndarray:
+def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_angle: float, symmetry=None) -> np.ndarray:
     """``(n,)`` bool: the object's back faces a wall of the floor ``outline (k, 2)`` (its back normal within
-    ``max_angle`` rad of the wall's outward normal) and its back side's midpoint lies within ``max_gap`` m of that
-    wall's inner face, over the wall's length."""
+    ``max_angle`` rad of the wall's outward normal; with ``symmetry (n,)``, any of a symmetric object's equivalent
+    backs) and that back side's midpoint lies within ``max_gap`` m of that wall's inner face, over the wall's
+    length."""
     b = np.asarray(boxes, float).reshape(-1, 7)
     walls = polygon_segments(make_ccw(np.asarray(outline, float)))
     normal = inward_normals(walls)  # (w, 2) into the room
-    back = -np.stack([-np.sin(b[:, 6]), np.cos(b[:, 6])], -1)  # (n, 2)
-    mid = b[:, :2] + back * b[:, 4:5]  # back side's midpoint
-    rel = mid[:, None] - walls[None, :, 0]  # (n, w, 2)
+    wall_yaw = np.arctan2(-normal[:, 0], normal[:, 1])  # the yaw whose front points into the room from the wall
+    sym = np.broadcast_to(np.asarray("none" if symmetry is None else symmetry, object), (len(b),))
+    err = turn_error(b[:, 6, None] - wall_yaw[None], sym[:, None])  # (n, w) turn off "back to this wall"
+    fold = np.array([FOLD.get(x, 1) for x in sym])[:, None]
+    step = 2 * np.pi / np.maximum(fold, 1)
+    eq = np.where(fold == 0, wall_yaw[None], b[:, 6, None] + step * np.round(wrap(wall_yaw[None] - b[:, 6, None]) / step))
+    depth = np.where(np.abs(np.sin(eq - b[:, 6, None])) > 0.5, b[:, 3, None], b[:, 4, None])  # (n, w)
+    mid = b[:, None, :2] + np.stack([np.sin(eq), -np.cos(eq)], -1) * depth[..., None]  # the equivalent back's midpoint
+    rel = mid - walls[None, :, 0]  # (n, w, 2)
     d = walls[:, 1] - walls[:, 0]
     along = np.einsum("nwj,wj->nw", rel, d) / np.maximum(np.einsum("wj,wj->w", d, d), 1e-18)
     off = np.einsum("nwj,wj->nw", rel, normal)  # distance in front of the wall's face
-    aligned = back @ (-normal).T >= np.cos(max_angle)
-    return np.any(aligned & (np.abs(off) <= max_gap) & (along >= 0.0) & (along <= 1.0), axis=1)
+    return np.any((err <= max_angle) & (np.abs(off) <= max_gap) & (along >= 0.0) & (along <= 1.0), axis=1)
+
+
+def off_axis(boxes: np.ndarray, outline: np.ndarray, angle: float, symmetry=None) -> np.ndarray:
+    """``(n,)`` float: 1.0 where an object's yaw lies more than ``angle`` rad off the axes of the wall nearest its
+    centre (a quarter turn of it), 0.0 where not, NaN for a radially symmetric object (its yaw means nothing)."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    walls = polygon_segments(make_ccw(np.asarray(outline, float)))
+    normal = inward_normals(walls)
+    a, d = walls[:, 0], walls[:, 1] - walls[:, 0]
+    t = np.clip(np.einsum("nwj,wj->nw", b[:, None, :2] - a[None], d) / np.maximum(np.einsum("wj,wj->w", d, d), 1e-18), 0, 1)
+    near = np.argmin(np.linalg.norm(a[None] + t[..., None] * d[None] - b[:, None, :2], axis=-1), axis=1)
+    wall_yaw = np.arctan2(-normal[near, 0], normal[near, 1])
+    out = (turn_error(b[:, 6] - wall_yaw, "rotational-4") > angle).astype(float)
+    sym = np.broadcast_to(np.asarray("none" if symmetry is None else symmetry, object), (len(b),))
+    return np.where(sym == "radial", np.nan, out)

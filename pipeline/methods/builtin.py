@@ -23,8 +23,9 @@ GRAPH_SOURCES = {s.name: s for s in [
 
 
 PLACEMENT_LEARNERS = {p.name: p for p in [
-    *(PlacementLearner(net, "pipeline.methods.planit.nets.fit:fit_from_tables", _preset_keys("placement"))
-      for net in ("cfcn", "fcn")),
+    *(PlacementLearner(net, "pipeline.methods.planit.nets.fit:fit_from_tables",
+                       _preset_keys("placement", "snap_angle", "none_share")) for net in ("cfcn", "fcn")),
+    PlacementLearner("prior", "pipeline.methods.planit.prior_fit:fit_prior", lambda config: ["seed", "placement.prior"]),
     PlacementLearner("grains", "pipeline.methods.grains.fit:fit_grains", _preset_keys("grains", "wall_gap")),
     PlacementLearner("tagger", "pipeline.methods.strings.tagfit:fit_tagger",
                      lambda config: ["seed", "strings.tagger.preset",
@@ -43,7 +44,7 @@ PROGRAM_LEARNERS = {p.name: p for p in [
 
 # what methods/placing.py's load_context reads (the model pool, the checker, learned support shares and pose rules):
 # a PlanIT search setting (instantiate.samples, ...) reruns none of the methods that only share this context
-CONTEXT_KEYS = ("extract", "floor_contact", "instantiate.checks", "instantiate.pose_rules",
+CONTEXT_KEYS = ("extract", "floor_contact", "instantiate.checks",
                 "evaluate.collision.penetration")
 
 
@@ -72,7 +73,10 @@ def _search(name: str, net: str, description: str, graphs: str = "planit") -> Me
 
 
 BUILTIN = [
-    _search("planit", "cfcn", "PlanIT: the graph model's sampled graphs placed by the search with the CFCN"),
+    _search("planit", "cfcn", "PlanIT: the graph model's sampled graphs placed by the search with the pose networks "
+            "(the CFCN and the orientation network, conditioned on every planned edge to what is placed)"),
+    _search("planit_prior", "prior", "the same graphs placed by the same search with a relative-pose prior learned "
+            "from the fit rooms (no network)"),
     _search("random_sampled", "cfcn", "the sampled graphs' objects at uniform random locations (collision-checked)"),
     _search("unconditional_sampled", "fcn", "the sampled graphs placed with the location network without FiLM"),
     _search("strings", "cfcn", "the string VAE's sampled graphs (Kalojanov et al.) placed by PlanIT's search with the "

@@ -1,6 +1,5 @@
 """What every layout generator that places objects with the project's placement checks shares (PlanIT's search, the
-string method's assembly): the context of one room type's scenes (model pool, checker, learned pose rules and
-support shares) and a searched scene as a :class:`~pipeline.methods.interface.Scene` with its search counts and
+string method's assembly): the context of one room type's scenes (model pool, checker, learned support shares) and a searched scene as a :class:`~pipeline.methods.interface.Scene` with its search counts and
 graph consistency. No torch."""
 from __future__ import annotations
 
@@ -13,7 +12,6 @@ from ..geometry.raycast import intersector_class
 from ..placement import scene_metrics
 from ..placement.checks import Checker, checks_config
 from ..placement.plan import ScenePlan
-from ..placement.poses import PoseRules, describe, learn_pose_rules
 from ..placement.retrieval import ModelPool
 from ..placement.support import learn_support_floor
 from .interface import Corpus, Scene
@@ -28,7 +26,6 @@ class Context:
     pool: ModelPool
     checker: Checker
     mean_area: dict
-    poses: PoseRules | None = None
 
 
 def load_context(config: dict, corpus: Corpus) -> Context:
@@ -45,12 +42,7 @@ def load_context(config: dict, corpus: Corpus) -> Context:
         log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
     objs = corpus.objects
     pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
-    rules = config["instantiate"]["pose_rules"]
-    poses = learn_pose_rules(training, rules) if rules["enabled"] else None
-    if poses is not None:
-        log.info("%s: %d pose rules learned from %d training rooms:\n  %s", corpus.room_type,
-                 len(poses.turns), len(training), "\n  ".join(describe(poses)))
-    return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])), poses)
+    return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))
 
 
 def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
@@ -60,7 +52,8 @@ def scene_of(plan: ScenePlan, ctx: Context, outcome, walls) -> Scene:
     record = {"seconds": outcome.seconds, "planned_objects": len(plan.ids), "placed_objects": len(room.object_ids),
               "insertions": outcome.insertions, "rejections": outcome.rejections, "backtracks": outcome.backtracks,
               "attempts": outcome.attempts, "failures": json.dumps(outcome.failures),
-              "drops": json.dumps(outcome.drops),
+              "drops": json.dumps(outcome.drops), "relaxed_objects": len(outcome.relaxed),
+              "relaxed": json.dumps(outcome.relaxed),
               **scene_metrics.consistency(plan, room, walls.ids, ctx.checker, outcome.dropped, outcome.accepted),
               "colliding_objects": scene_metrics.colliding_objects(room, parents, ctx.checker)}
     return Scene(plan.scene_id, plan.room_id, room, walls, outcome.status, outcome.reason, record, plan.edges, parents)

@@ -107,6 +107,7 @@ def summarise(scenes: pd.DataFrame) -> dict:
             "collision_rate": _round(total("colliding_objects") / max(total("placed_objects"), 1), 4),
             "median_seconds": _round(scenes["seconds"].median(), 3),
             "unplanned_adjacent_per_scene": _round(scenes["unplanned_adjacent"].mean(), 3),
+            "relaxed_share": relaxed_share(scenes[scored]), "relaxed": relaxed(scenes.loc[scored, "relaxed"]),
             "plan_loss": plan_loss(scenes.loc[scored, "plan_loss"]), "drops": drops(scenes.loc[scored, "drops"])}
 
 
@@ -131,6 +132,24 @@ def drops(rows: pd.Series) -> dict:
             cause = f"{d['cause']}:{d['check']}" if d.get("check") else d["cause"]
             acc = total.setdefault(d["category"], {})
             acc[cause] = acc.get(cause, 0) + 1
+    return {c: dict(sorted(v.items())) for c, v in sorted(total.items())}
+
+
+def relaxed_share(scenes: pd.DataFrame):
+    """Share of the placed objects kept with a broken planned relation (None where no scene records it)."""
+    if scenes.empty or scenes["relaxed_objects"].isna().all():
+        return None
+    return _round(scenes["relaxed_objects"].fillna(0).sum() / max(scenes["placed_objects"].sum(), 1), 4)
+
+
+def relaxed(rows: pd.Series) -> dict:
+    """Category -> cause (the check that refused the object most before it was kept broken) -> objects, over the
+    scenes' ``relaxed`` JSON rows."""
+    total: dict = {}
+    for row in rows.dropna():
+        for r in json.loads(row):
+            acc = total.setdefault(r["category"], {})
+            acc[str(r["cause"])] = acc.get(str(r["cause"]), 0) + 1
     return {c: dict(sorted(v.items())) for c, v in sorted(total.items())}
 
 

@@ -26,6 +26,7 @@ class Verdict:
     cost: float = 0.0  # violation cost of the object's planned relations, in [0, 1]
     culprits: set[str] = field(default_factory=set)  # placed objects that caused the failure
     edge_costs: list = field(default_factory=list)  # (PlanEdge, cost) of the object's planned relations
+    found: dict = field(default_factory=dict)  # the extracted edges by (source, target) (found_edges), when measured
 
 
 def checks_config(config: dict) -> dict:
@@ -119,16 +120,17 @@ def blocks_door(room: RoomInput, corners: np.ndarray, depth: float) -> bool:
     return bool((overlap > AREA_EPS).any())
 
 
-def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str], list[float]]:
+def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str], list[float], dict]:
     """Mean cost of ``planned`` edges (each between the new object and a node already in the room) on the room's
-    extracted graph, the objects at the other end of the edges not found exactly, and each edge's cost."""
+    extracted graph, the objects at the other end of the edges not found exactly, each edge's cost, and the extracted
+    edges (:func:`found_edges`)."""
     if not planned:
-        return 0.0, set(), []
+        return 0.0, set(), [], {}
     found = found_edges(checker.extract(room, anchors={e.source for e in planned}).edges)
     costs = [edge_cost(e, found) for e in planned]
     objects = set(room.object_ids)
     blame = {n for e, c in zip(planned, costs) if c > 0 for n in (e.source, e.target) if n in objects}
-    return float(np.mean(costs)), blame, costs
+    return float(np.mean(costs)), blame, costs, found
 
 
 def check(room: RoomInput, k: int, parent: int | None, children: set[int], planned: list[PlanEdge],
@@ -151,7 +153,7 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
         hit = collision(room, k, related, checker)
         if hit is not None:
             return collides(room, hit)
-    cost, blame, costs = relation_cost(room, planned, checker)
+    cost, blame, costs, found = relation_cost(room, planned, checker)
     blame.discard(me)
     if cost > tolerance or (cost >= 1.0 and planned):
         return Verdict(False, f"violates its relations (cost {cost:.2f})", cost, blame)
@@ -159,7 +161,7 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
         hit = collision(room, k, related, checker)
         if hit is not None:
             return collides(room, hit)
-    return Verdict(True, cost=cost, edge_costs=list(zip(planned, costs)))
+    return Verdict(True, cost=cost, edge_costs=list(zip(planned, costs)), found=found)
 
 
 def collides(room: RoomInput, hit: tuple[int, float]) -> Verdict:

@@ -1,74 +1,179 @@
-"""Proposers without networks: uniform locations (the "random location" ablation of PlanIT's Table 3) and the
-orientation rule "face away from the nearest wall" (used where no orientation network is given). The network
-proposer is :class:`pipeline.methods.planit.nets.proposer.NetProposer`."""
+"""Proposers without networks, and what every proposer answers: a pose (centre and yaw) for the object being placed
+(:class:`Request`). A :class:`DensityProposer` draws it PlanIT's way, location first from a density over the
+candidate centres, then the orientation at that location; the relative-pose prior (``placement/prior.py``) draws
+whole poses. Here: uniform locations (the "random location" ablation of PlanIT's Table 3), the relation bands
+(:class:`RelationPrior`: where extraction would find each planned edge) and the orientation rule "face away from the
+nearest wall". The network proposer is :class:`pipeline.methods.planit.nets.proposer.NetProposer`."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..room import RoomInput, Walls
-from ..geometry.polygon import segment_distances
-from ..geometry.boxes import SIDES
+from ..geometry import raster
+from ..geometry.boxes import SIDES, diagonal_2d
 from ..geometry.frames import to_local
+from ..geometry.polygon import segment_distances
+from ..room import RoomInput, Walls
+from .anchors import Anchor
 from .layout import wall_frame
 
-# how far beyond an anchor's side (m) a target's centre may lie: (from, to) as (its small half extent, its large
-# half extent) plus these offsets, per distance label (RelationPrior)
-BANDS = {"adjacent": (-0.05, 0.15), "proximal": (0.03, 0.6), "distant": (0.3, np.inf)}
+
+@dataclass
+class Request:
+    """The object being placed: its category and symmetry, its anchors (:class:`~pipeline.placement.anchors.Anchor`)
+    in the room as it stands, the candidate centres (:class:`Grid`) and which of them are allowed ``mask (cells,)``
+    (on the floor or its support's top, off what stands there, outside rejected squares)."""
+    room: RoomInput
+    walls: Walls
+    category: str
+    symmetry: str
+    anchors: list[Anchor]
+    grid: "Grid"
+    mask: np.ndarray
+
+    @property
+    def points(self) -> np.ndarray:
+        return self.grid.points
+
+
+class Grid:
+    """Candidate centres: cell centres over the room's bounding square at ``mpp``, and those on the floor."""
+
+    def __init__(self, outline: np.ndarray, mpp: float):
+        lo, hi = outline.min(0), outline.max(0)
+        self.mpp = mpp
+        self.size = int(np.ceil((hi - lo).max() / mpp)) + 2
+        self.centre = (lo + hi) / 2
+        xs, ys = raster.pixel_centres(self.size, mpp, self.centre)
+        self.points = np.stack(np.meshgrid(xs, ys), -1).reshape(-1, 2)
+        self.floor = raster.fill_polygon(outline, self.size, mpp, self.centre).reshape(-1)
+
+    def cells(self, xy: np.ndarray) -> np.ndarray:
+        """``(m,)`` index of the cell holding each point ``xy (m, 2)`` (-1 outside the grid)."""
+        k = np.asarray(xy, float) - self.centre
+        col = np.floor(k[:, 0] / self.mpp + self.size / 2).astype(int)
+        row = np.floor(self.size / 2 - k[:, 1] / self.mpp).astype(int)
+        ok = (row >= 0) & (row < self.size) & (col >= 0) & (col < self.size)
+        return np.where(ok, row * self.size + col, -1)
 
 
 def nearest_wall(walls: Walls, xy: np.ndarray) -> int:
     return int(np.argmin(segment_distances(np.asarray(xy, float), np.stack([walls.a, walls.b], 1))))
 
 
-class UniformLocation:
+class DensityProposer:
+    """PlanIT's order: a centre drawn from ``density`` over the allowed candidates (uniformly within its cell), then
+    a yaw from ``orientation`` at that centre."""
+
+    def density(self, room: RoomInput, walls: Walls, category: str, anchors: list[Anchor], points: np.ndarray) -> np.ndarray:
+        """``(m,)`` unnormalised density of the object's centre at ``points (m, 2)``."""
+        raise NotImplementedError
+
+    def orientation(self, req: Request, xy: np.ndarray, rng: np.random.Generator) -> float:
+        """A yaw (rad) for the requested object centred at ``xy (2,)``."""
+        raise NotImplementedError
+
+    def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        """A centre ``(2,)`` and yaw, or None when no allowed candidate has mass."""
+        if not req.mask.any():
+            return None
+        p = self.density(req.room, req.walls, req.category, req.anchors, req.points) * req.mask
+        if not np.isfinite(p).all() or p.sum() <= 0:
+            p = req.mask.astype(float)
+        cell = rng.choice(len(p), p=p / p.sum())
+        xy = req.points[cell] + rng.uniform(-0.5, 0.5, 2) * req.grid.mpp
+        return xy, self.orientation(req, xy, rng)
+
+
+class UniformLocation(DensityProposer):
     """Every candidate centre equally likely (before the floor / support mask)."""
 
-    def density(self, room: RoomInput, walls: Walls, category: str, anchors, points: np.ndarray) -> np.ndarray:
+    def density(self, room, walls, category, anchors, points) -> np.ndarray:
         return np.ones(len(points))
 
 
-class RelationPrior:
-    """No network: each anchor allows the band beyond its side named by the edge's direction, as deep as
-    :data:`BANDS` says for the edge's distance and as wide as the side plus ``margin`` m; anchors multiply. A
-    baseline, and the proposer of the tests that must not depend on training."""
+def gap_thresholds(a: Anchor, room: RoomInput, walls: Walls, extract: dict) -> tuple[float, float]:
+    """The largest gaps (m) at which extraction labels the anchor's edge to the placed object (half extents
+    ``a.target_half``) adjacent and proximal: ``extract.distance``'s thresholds for the larger footprint diagonal of
+    the two (a wall's is the object's)."""
+    anchor_diag = 0.0 if a.wall is not None else float(diagonal_2d(*room.boxes[a.obj, 3:5]))
+    diag = max(anchor_diag, float(diagonal_2d(*a.target_half)))
+    d = extract["distance"]
+    return min(d["adjacent_abs"], d["adjacent_rel"] * diag), max(d["proximal_abs"], d["proximal_rel"] * diag)
 
-    def __init__(self, margin: float = 0.6, soft: float = 0.0):
-        self.margin, self.soft = margin, soft  # soft: the density outside a band (0: none)
 
-    def density(self, room: RoomInput, walls: Walls, category: str, anchors, points: np.ndarray) -> np.ndarray:
+def band_limits(a: Anchor, room: RoomInput, walls: Walls, extract: dict, slack: float):
+    """Where a target's centre may lie beyond the anchor side its spatial edge names for extraction to find that edge:
+    ``(side half length, depth range (lo, hi) m beyond the side, largest |along| m)``. Depth follows the distance
+    label's gap thresholds (:func:`gap_thresholds`) for any turn of the target (its half extents: smaller ``s``, larger
+    ``l``), widened by ``slack`` m; along keeps the share of the target or of the side that must be visible
+    (``extract.spatial.min_visibility``) for the target's smallest extent along the side."""
+    s, l = min(a.target_half), max(a.target_half)
+    if a.wall is not None:
+        half_len = walls.length[a.wall] / 2
+    else:
+        hx, hy = room.boxes[a.obj, 3:5]
+        half_len = hx if SIDES.index(a.direction) < 2 else hy
+    adj, prox = gap_thresholds(a, room, walls, extract)
+    depth = {"adjacent": (s - slack, l + adj + slack), "proximal": (s + adj - slack, l + prox + slack),
+             "distant": (s + prox - slack, np.inf)}[a.distance]
+    return half_len, depth, half_len + s - 2 * extract["spatial"]["min_visibility"] * min(half_len, s)
+
+
+def side_coordinates(a: Anchor, room: RoomInput, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(m,)`` depth of ``points`` beyond the anchor's side its edge names (m, from the side's line) and their
+    coordinate along it (from its middle)."""
+    local = to_local(a.frame, points)
+    if a.wall is not None:
+        return local[:, 1], local[:, 0]
+    hx, hy = room.boxes[a.obj, 3:5]
+    s = SIDES.index(a.direction)
+    axis, sign = (1, 1.0 if s == 0 else -1.0) if s < 2 else (0, -1.0 if s == 2 else 1.0)
+    return sign * local[:, axis] - (hy if axis == 1 else hx), local[:, 1 - axis]
+
+
+class RelationPrior(DensityProposer):
+    """No network: each spatial edge from a placed anchor allows the band beyond the anchor's side where extraction
+    would find it (:func:`band_limits`); anchors multiply, support and reverse edges leave every point. A baseline,
+    the relation mask over the networks' densities, and the proposer of the tests that must not depend on training.
+    ``extract``: the extraction config (``distance`` and ``spatial`` thresholds)."""
+
+    def __init__(self, extract: dict, soft: float = 0.0, slack: float = 0.05):
+        self.extract, self.soft, self.slack = extract, soft, slack  # soft: the density outside a band (0: none)
+
+    def density(self, room, walls, category, anchors, points) -> np.ndarray:
         out = np.ones(len(points))
         for a in anchors:
-            local = to_local(a.frame, points)
-            if a.wall is not None:
-                depth, along, half_len = local[:, 1], local[:, 0], walls.length[a.wall] / 2
-            else:
-                hx, hy = room.boxes[a.obj, 3:5]
-                s = SIDES.index(a.direction)
-                axis, sign = (1, 1.0 if s == 0 else -1.0) if s < 2 else (0, -1.0 if s == 2 else 1.0)
-                depth = sign * local[:, axis] - (hy if axis == 1 else hx)
-                along, half_len = local[:, 1 - axis], (hx if axis == 1 else hy)
-            lo, hi = BANDS[a.distance]
-            small, large = min(a.target_half), max(a.target_half)
-            inside = (depth >= small + lo) & (depth <= large + hi) & (np.abs(along) <= half_len + self.margin)
-            out *= np.where(inside, 1.0, self.soft)
+            if a.kind == "spatial" and not a.reverse:
+                out *= np.where(self.band(a, room, walls, points), 1.0, self.soft)
         return out
+
+    def band(self, a: Anchor, room: RoomInput, walls: Walls, points: np.ndarray) -> np.ndarray:
+        """``(m,)`` bool: the points in anchor ``a``'s band; a radially symmetric anchor's edges are all labelled
+        front by extraction, so its band is the union of its four sides'."""
+        sides = SIDES if a.obj is not None and a.symmetry == "radial" else (a.direction,)
+        inside = np.zeros(len(points), bool)
+        for side in sides:
+            s = replace(a, direction=side)
+            _, (lo, hi), reach = band_limits(s, room, walls, self.extract, self.slack)
+            depth, along = side_coordinates(s, room, points)
+            inside |= (depth >= lo) & (depth <= hi) & (np.abs(along) <= reach)
+        return inside
 
 
 class FaceAway:
     """Front turned away from the nearest wall (into the room)."""
 
-    def orientation(self, room: RoomInput, walls: Walls, category: str, symmetry: str, xy: np.ndarray,
-                    rng: np.random.Generator) -> float:
-        return wall_frame(walls, nearest_wall(walls, xy)).yaw
+    def orientation(self, req: Request, xy: np.ndarray, rng: np.random.Generator) -> float:
+        return wall_frame(req.walls, nearest_wall(req.walls, xy)).yaw
 
 
-@dataclass
-class Combined:
+class Combined(DensityProposer):
     """Locations from one proposer, orientations from another."""
-    location: object
-    orienter: object
+
+    def __init__(self, location, orienter):
+        self.location, self.orienter = location, orienter
 
     def density(self, *args) -> np.ndarray:
         return self.location.density(*args)
@@ -77,12 +182,12 @@ class Combined:
         return self.orienter.orientation(*args)
 
 
-@dataclass
-class Masked:
+class Masked(DensityProposer):
     """A proposer whose densities are weighted by ``mask``'s (e.g. the network's by the relation bands: with soft
     bands, where fewer relations can hold is unlikely, not impossible)."""
-    base: object
-    mask: object
+
+    def __init__(self, base, mask):
+        self.base, self.mask = base, mask
 
     def density(self, *args) -> np.ndarray:
         return self.base.density(*args) * self.mask.density(*args)

@@ -38,7 +38,7 @@ def reinstantiate(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.D
             continue
         room = with_objects(inputs[plan.room_id], [])
         walls = walls_of(room)
-        out = instantiate(plan, room, walls, order.placement_order(plan, areas), Combined(RelationPrior(), FaceAway()),
+        out = instantiate(plan, room, walls, order.placement_order(plan, areas), Combined(RelationPrior(config["extract"]), FaceAway()),
                           pool, checker, ic, seed)
         m = scene_metrics.consistency(plan, out.room, walls.ids, checker)
         rows.append({"room_id": plan.room_id, "objects": len(plan.ids), "placed": out.status == "placed", "reason": out.reason,

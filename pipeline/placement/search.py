@@ -1,65 +1,53 @@
 """Placing a planned graph's objects one at a time with backtracking (PlanIT section 6, Appendix B).
 
-Each object samples a location from the proposer's density (a product over its placed anchors, masked to the
-floor or its support's top, minus squares around the points already rejected), an orientation, and a model; it
-slides flush against the anchors it must be adjacent to, then must pass :func:`~pipeline.placement.checks.check`.
-After its sample budget, the search backtracks to the nearest earlier object that caused one of its failures (or
-the one before it) and that object is placed afresh elsewhere. The relation tolerance stays 0 for the first
-quarter of the backtrack budget, then grows as ``((b - B/4) / (3B/4)) ** 1.5``; with ``keep_relations``, a candidate
-that breaks some of its relations within that tolerance is kept only when the object's remaining samples find none
-that keeps them all (the cheapest such candidate is taken). With ``early_backtrack``, an object at zero
-tolerance whose planned bands share no free cell backtracks at once instead of spending its samples. A scene fails, with its reason,
-when the backtrack or candidate budget runs out (or the time budget, a safety net: the one outcome a machine's
-speed can change), or an object's category has no training instance; with
-``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search goes on.
-A scene whose backtrack budget runs out starts over from scratch with a fresh seed, at most ``restarts`` times (each
-attempt with its own budgets); its counts add up over the attempts.
+Each object asks the proposer for a pose (:class:`~pipeline.placement.proposers.Request`): a centre among the
+allowed candidates (the floor or its support's top, off what stands there, outside the squares around its rejected
+points) and a yaw, conditioned on its anchors (every planned edge to what is already placed); it slides flush against
+the anchors it must be adjacent to, then must pass :func:`~pipeline.placement.checks.check`. After its sample budget,
+the search backtracks to the nearest earlier object that caused one of its failures (or the one before it) and that
+object is placed afresh elsewhere. The relation tolerance is 0 until an object has failed ``relax.start`` times
+(``per_object``; PlanIT: until the scene has spent a quarter of its backtracks), then grows as
+``((f - start) / (full - start)) ** 1.5`` up to ``relax.max``; an object accepted with a broken relation is recorded with the edges it
+broke and why (:attr:`Outcome.relaxed`). A rejected point's square is sized to the object (``per_object``: a share of
+its smaller half extent, growing with its failures; PlanIT: 0.6 m growing with the scene's backtracks). With
+``keep_relations``, a candidate that breaks some of its relations within that tolerance is kept only when the
+object's remaining samples find none that keeps them all (the cheapest such candidate is taken). With
+``early_backtrack``, an object at zero tolerance whose planned bands share no free cell backtracks at once instead of
+spending its samples. A scene fails, with its reason, when the backtrack or candidate budget runs out (or the time
+budget, a safety net: the one outcome a machine's speed can change), or an object's category has no training
+instance; with ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the
+search goes on. A scene whose backtrack budget runs out starts over from scratch with a fresh seed, at most
+``restarts`` times (each attempt with its own budgets); its counts add up over the attempts. With ``redraw``, an
+object that spends its samples draws another training instance of its category (shared with its hub's spokes or
+its chain's members from then on): models are drawn at random, not by a predicted size, and a size that cannot fit
+is not forced on the object again.
 """
 from __future__ import annotations
 
 import logging
 import time
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
 
 from ..room import RoomInput, Walls
-from ..geometry import raster
 from ..geometry.boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
-from ..geometry.frames import Frame
+from .anchors import Anchor, anchors_of, planned_edges
 from .checks import Checker, check
-from .layout import add_object, box_frame, wall_frame, with_objects
+from .layout import add_object, with_objects
 from .order import chains
-from .plan import PlanEdge, ScenePlan
-from .poses import PoseRules
-from .proposers import RelationPrior
+from .plan import ScenePlan
+from .proposers import Grid, RelationPrior, Request, gap_thresholds
 from .retrieval import ModelPool, place
 
 log = logging.getLogger("planit.instantiate")
 
 
-@dataclass
-class Anchor:
-    """A placed node with a planned spatial edge to the object being placed."""
-    node: str
-    frame: Frame
-    symmetry: str
-    direction: str
-    distance: str
-    obj: int | None = None  # index among the room's objects
-    wall: int | None = None  # index among the room's walls
-    target_half: tuple[float, float] = (0.0, 0.0)  # half extents (x, y) of the object being placed
-
-
 class Proposer(Protocol):
-    def density(self, room: RoomInput, walls: Walls, category: str, anchors: list[Anchor], points: np.ndarray) -> np.ndarray:
-        """``(m,)`` unnormalised density of the object's centre at ``points (m, 2)``."""
-
-    def orientation(self, room: RoomInput, walls: Walls, category: str, symmetry: str, xy: np.ndarray,
-                    rng: np.random.Generator) -> float:
-        """A yaw (rad) for an object of the category centred at ``xy``."""
+    def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        """A centre ``(2,)`` among ``req``'s allowed candidates and a yaw (rad), or None when none has mass."""
 
 
 @dataclass
@@ -77,6 +65,7 @@ class Outcome:
     drops: list = field(default_factory=list)  # per dropped id: its category, cause and (no_place) the check that refused it most
     attempts: int = 1  # searches from scratch (1 + restarts used)
     accepted: dict = field(default_factory=dict)  # PlanEdge -> its cost when the later of its two ends was placed
+    relaxed: list = field(default_factory=list)  # per object accepted with a broken relation: what it broke and why
 
     @property
     def status(self) -> str:
@@ -86,42 +75,6 @@ class Outcome:
 DROP_CAUSES = {"no_place": "no place once the backtrack budget was spent", "no_model": "no training instance",
                "support_dropped": "support dropped"}
 SCORED = ("placed", "partial")  # the statuses of scenes that hold a room to score (a partial one lacks what it dropped)
-
-
-class Grid:
-    """Candidate centres: cell centres over the room's bounding square at ``mpp``, and those on the floor."""
-
-    def __init__(self, outline: np.ndarray, mpp: float):
-        lo, hi = outline.min(0), outline.max(0)
-        self.mpp = mpp
-        self.size = int(np.ceil((hi - lo).max() / mpp)) + 2
-        self.centre = (lo + hi) / 2
-        xs, ys = raster.pixel_centres(self.size, mpp, self.centre)
-        self.points = np.stack(np.meshgrid(xs, ys), -1).reshape(-1, 2)
-        self.floor = raster.fill_polygon(outline, self.size, mpp, self.centre).reshape(-1)
-
-
-def anchors_of(v: str, plan: ScenePlan, room: RoomInput, walls: Walls, sym: dict[str, str],
-               half: tuple[float, float] = (0.0, 0.0)) -> list[Anchor]:
-    """The placed objects and walls with a planned spatial edge to ``v`` (whose half extents are ``half``)."""
-    obj = {o: k for k, o in enumerate(room.object_ids)}
-    wall = {w: k for k, w in enumerate(walls.ids)}
-    out = []
-    for e in plan.edges:
-        if e.target != v or e.edge_type != "spatial":
-            continue
-        if e.source in obj:
-            k = obj[e.source]
-            out.append(Anchor(e.source, box_frame(room.boxes[k]), sym.get(e.source, "none"), e.direction, e.distance, obj=k, target_half=half))
-        elif e.source in wall:
-            k = wall[e.source]
-            out.append(Anchor(e.source, wall_frame(walls, k), "none", e.direction, e.distance, wall=k, target_half=half))
-    return out
-
-
-def planned_edges(v: str, plan: ScenePlan, present: set[str]) -> list[PlanEdge]:
-    """Planned support and spatial edges between ``v`` and nodes already present (objects or walls)."""
-    return [e for e in plan.edges if (e.target == v and e.source in present) or (e.source == v and e.target in present)]
 
 
 def side_plane(a: Anchor, room: RoomInput) -> tuple[np.ndarray, np.ndarray]:
@@ -134,15 +87,22 @@ def side_plane(a: Anchor, room: RoomInput) -> tuple[np.ndarray, np.ndarray]:
     return b[:2] + normal * (b[4] if s < 2 else b[3]), normal
 
 
-def snap(box: np.ndarray, anchors: list[Anchor], room: RoomInput, gaps: dict, reach: float) -> np.ndarray:
+def snap(box: np.ndarray, anchors: list[Anchor], room: RoomInput, walls: Walls, extract: dict, cfg: dict) -> np.ndarray:
     """Slide ``box (7,)`` along the normal of each anchor side it is planned adjacent or proximal to (walls first)
-    until its footprint's gap to the side lies in ``gaps[distance] = (lo, hi)`` m, when the slide is under
-    ``reach`` m and the box is on the side's outer half-space (or across a wall)."""
+    until its footprint's gap to the side is where extraction finds that label: ``cfg['gap']`` m for adjacent, for
+    proximal inside the extraction's proximal band (:func:`~pipeline.placement.proposers.gap_thresholds`) by
+    ``cfg['margin']`` m at both ends; only when the slide is under ``cfg['reach']`` m and the box is on the side's
+    outer half-space (or across a wall). ``cfg``: the ``instantiate.snap`` section (``enabled``: else no slide)."""
     box = box.copy()
-    for a in sorted((a for a in anchors if a.distance in gaps), key=lambda a: a.wall is None):
+    if not cfg["enabled"]:
+        return box
+    reach = cfg["reach"]
+    spatial = (a for a in anchors if a.kind == "spatial" and not a.reverse and a.distance in ("adjacent", "proximal"))
+    for a in sorted(spatial, key=lambda a: a.wall is None):
         point, normal = side_plane(a, room)
         d = float(((footprint_corners(*box[[0, 1, 3, 4, 6]])[0] - point) @ normal).min())
-        lo, hi = gaps[a.distance]
+        adj, prox = gap_thresholds(replace(a, target_half=tuple(box[3:5])), room, walls, extract)
+        lo, hi = (cfg["gap"], cfg["gap"]) if a.distance == "adjacent" else (adj + cfg["margin"], prox - cfg["margin"])
         want = min(max(d, lo), hi)
         if abs(want - d) < reach and (a.wall is not None or d > -reach):  # never leave a footprint through a wall
             box[:2] += normal * (want - d)
@@ -167,10 +127,9 @@ def inside_walls(box: np.ndarray, walls: Walls, gap: float, reach: float) -> np.
     return box
 
 
-def tolerance(backtracks: int, budget: int) -> float:
-    """Violation cost allowed after ``backtracks`` of ``budget`` (0 for the first quarter, then growing)."""
-    start = budget / 4
-    return 0.0 if backtracks < start else min(1.0, ((backtracks - start) / max(budget - start, 1e-9)) ** 1.5)
+def tolerance(failures: float, start: float, full: float) -> float:
+    """Violation cost allowed after ``failures`` (0 before ``start``, then growing to 1 at ``full``)."""
+    return 0.0 if failures < start else min(1.0, ((failures - start) / max(full - start, 1e-9)) ** 1.5)
 
 
 def _in_box(points: np.ndarray, b: np.ndarray, inset=(0.0, 0.0), least: float = 0.0) -> np.ndarray:
@@ -187,37 +146,41 @@ class Search:
     """One scene's search state."""
 
     def __init__(self, plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer,
-                 pool: ModelPool, checker: Checker, cfg: dict, rng: np.random.Generator, poses: PoseRules | None = None):
-        self.plan, self.walls, self.order, self.poses = plan, walls, order, poses
+                 pool: ModelPool, checker: Checker, cfg: dict, rng: np.random.Generator):
+        self.plan, self.walls, self.order = plan, walls, order
         self.proposer, self.pool, self.checker, self.cfg, self.rng = proposer, pool, checker, cfg, rng
         self.fixed = len(room.object_ids)  # objects given (completion) are never moved
         self.room = room
         self.grid = Grid(room.outline, cfg["grid_mpp"])
-        sn = cfg["snap"]
-        self.gaps = {"adjacent": (sn["gap"], sn["gap"]), "proximal": tuple(sn["proximal"])}
+        self.bands = RelationPrior(checker.extract_cfg, slack=cfg["band_slack"])
         self.sym = dict(zip(plan.ids, plan.symmetry)) | {o: "none" for o in room.object_ids if o not in plan.ids}
-        self.rejected: dict[str, list[tuple[float, float]]] = {}
+        self.rejected: dict[str, list[tuple[float, float, float]]] = {}  # plan id -> (x, y, half side) of squares
         self.shared: dict[tuple, object] = {}
         self.unit = {}
         self.backtracks = self.rejections = self.insertions = self.candidates = 0
+        self.strikes: Counter = Counter()  # plan id -> times it spent its samples without a place
         self.failures: dict[str, int] = {}
         self.dropped: list[str] = []
         self.drops: list[dict] = []  # why each was dropped (``drop``)
         self.refusals: dict[str, Counter] = {}  # plan id -> rejections by check (``nowhere`` included)
         self.accepted: dict = {}  # PlanEdge -> cost when its later end was last placed
+        self.relaxed: dict[str, dict] = {}  # plan id -> its broken relations and why, as last placed
         self.exhausted = False  # the backtrack budget ran out (the one failure a restart may cure)
         self._free = None  # the last free_floor: (room boxes and grow, cells)
+
+    def model_key(self, k: int) -> tuple:
+        """Which instance object ``k`` shares: its own, its hub's spokes', or its chain's."""
+        cat = self.plan.categories[k]
+        if self.plan.role[k] == "spoke":
+            hubs = [e.source for e in self.plan.edges if e.target == self.plan.ids[k] and e.source in self.plan.ids
+                    and "hub" in self.plan.role[self.plan.index(e.source)]]
+            return ("spoke", hubs[0] if hubs else None, cat)
+        return ("chain", self.unit[k], cat) if k in self.unit else ("own", k)
 
     def model_for(self, k: int):
         """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's; a floor node
         with planned spatial edges takes one that stood on the floor (:meth:`ModelPool.pick`)."""
-        cat, key = self.plan.categories[k], ("own", k)
-        if self.plan.role[k] == "spoke":
-            hubs = [e.source for e in self.plan.edges if e.target == self.plan.ids[k] and e.source in self.plan.ids
-                    and "hub" in self.plan.role[self.plan.index(e.source)]]
-            key = ("spoke", hubs[0] if hubs else None, cat)
-        elif k in self.unit:
-            key = ("chain", self.unit[k], cat)
+        cat, key = self.plan.categories[k], self.model_key(k)
         if key not in self.shared:
             v = self.plan.ids[k]
             grounded = self.plan.parent[k] is None and any(
@@ -240,23 +203,24 @@ class Search:
             self._free = (key, self.grid.floor & ~self.occupied(grow))
         return self._free[1].copy()
 
-    def free_top(self, pk: int, inset, half) -> np.ndarray:
-        """``(cells,)`` candidate centres on placed object ``pk``'s top shrunk by ``inset (2,)`` m (each half extent
-        kept >= half a cell), with ``free_support`` off the footprints (grown by the smaller of ``half (2,)``) of the
-        objects already standing on it."""
+    def free_top(self, pk: int, half) -> np.ndarray:
+        """``(cells,)`` candidate centres on placed object ``pk``'s top shrunk by the smaller of ``half (2,)`` (any
+        turn of the object; each half extent kept >= half a cell), with ``free_support`` off the footprints (grown
+        the same) of the objects already standing on it."""
         pb = self.room.boxes[pk]
-        top = _in_box(self.grid.points, pb, inset, self.grid.mpp / 2)
+        grow = float(min(half))
+        top = _in_box(self.grid.points, pb, (grow, grow), self.grid.mpp / 2)
         if not self.cfg["free_support"]:
             return top
         b = self.room.boxes.reshape(-1, 7)
         on = np.abs(b[:, 2] - b[:, 5] - (pb[2] + pb[5])) < self.cfg["checks"]["collision"] + 0.05
         on[pk] = False
-        return top & ~_in_box(self.grid.points, b[on], (-float(min(half)),) * 2).any(0) if on.any() else top
+        return top & ~_in_box(self.grid.points, b[on], (-grow, -grow)).any(0) if on.any() else top
 
     def band_cells(self, anchors: list[Anchor], half) -> np.ndarray:
         """``(cells,)`` :meth:`free_floor` cells inside every anchor's planned band
         (:class:`~pipeline.placement.proposers.RelationPrior`, no softness)."""
-        return self.free_floor(half) & (RelationPrior().density(self.room, self.walls, "", anchors, self.grid.points) > 0)
+        return self.free_floor(half) & (self.bands.density(self.room, self.walls, "", anchors, self.grid.points) > 0)
 
     def nowhere(self, k: int, tol: float) -> set[str] | None:
         """With ``early_backtrack``, at zero tolerance: the placed objects among floor object ``k``'s anchors when
@@ -269,40 +233,60 @@ class Search:
             return None
         return {a.node for a in anchors if a.obj is not None}
 
-    def propose(self, k: int, half: float):
-        """A candidate box and pose for object ``k``, or None when no location has mass left. A supported object
-        turns first (to its support's axes) so that its footprint can be kept on the support's top."""
-        v, cat, sym = self.plan.ids[k], self.plan.categories[k], self.plan.symmetry[k]
-        inst = self.model_for(k)
-        anchors = anchors_of(v, self.plan, self.room, self.walls, self.sym, inst.half[:2])
+    def tolerance(self, v: str) -> float:
+        """The violation cost object ``v`` may be accepted with now: after its own failures (``per_object``), or
+        after the scene's backtracks (PlanIT: from a quarter of the budget)."""
+        if self.cfg["per_object"]:
+            relax = self.cfg["relax"]
+            return min(relax["max"], tolerance(self.strikes[v], relax["start"], relax["full"]))
+        budget = self.cfg["max_backtracks"]
+        return tolerance(self.backtracks, budget / 4, budget)
+
+    def reject_half(self, v: str, half) -> float:
+        """Half side (m) of the square a rejected point of object ``v`` (half extents ``half (2,)``) clears: a share
+        of its smaller half extent growing with its failures, never beyond it (``per_object``), or PlanIT's square
+        growing with the scene's backtracks."""
+        if self.cfg["per_object"]:
+            small = float(min(half))
+            grown = self.cfg["reject_fraction"] * small * self.cfg["reject_growth"] ** self.strikes[v]
+            return max(self.grid.mpp / 2, min(grown, small))
+        return min(self.cfg["reject_half"] * self.cfg["reject_growth"] ** self.backtracks, self.cfg["reject_max_half"])
+
+    def culprit_half(self, u: str, i: int) -> float:
+        """Half side of the square cleared around culprit ``u``'s place when object ``order[i]`` backtracks to it: its
+        own square, or (``per_object``) at least the failing object's smaller half extent, so that the culprit moves
+        far enough to leave it room."""
+        own = self.reject_half(u, self.room.boxes[self.room.object_ids.index(u), 3:5])
+        if not self.cfg["per_object"]:
+            return own
+        return max(own, float(min(self.model_for(self.order[i]).half[:2])))
+
+    def request(self, k: int, inst) -> tuple[Request, int | None]:
+        """What the proposer is asked for object ``k`` (instance ``inst``), and its support's index in the room."""
+        v, half = self.plan.ids[k], inst.half[:2]
         parent = self.plan.parent[k]
         pk = self.room.object_ids.index(parent) if parent in self.room.object_ids else None
-        if pk is None:  # on the floor, off the floor objects' footprints
-            mask, yaw = self.free_floor(inst.half[:2]), None
-        else:
-            pb = self.room.boxes[pk]
-            yaw = self.proposer.orientation(self.room, self.walls, cat, sym, pb[:2], self.rng)
-            turns = int(np.round((yaw - pb[6]) / (np.pi / 2)))
-            yaw = float(pb[6] + turns * np.pi / 2)
-            inset = inst.half[:2][::-1] if turns % 2 else inst.half[:2]
-            mask = self.free_top(pk, inset, inst.half[:2])
-        for x, y in self.rejected.get(v, []):
-            mask &= (np.abs(self.grid.points[:, 0] - x) > half) | (np.abs(self.grid.points[:, 1] - y) > half)
-        if not mask.any():
+        mask = self.free_floor(half) if pk is None else self.free_top(pk, half)
+        scene = None if self.cfg["per_object"] else self.reject_half(v, half)  # PlanIT: every square grows with the scene
+        for x, y, r in self.rejected.get(v, []):
+            r = r if scene is None else scene
+            mask &= (np.abs(self.grid.points[:, 0] - x) > r) | (np.abs(self.grid.points[:, 1] - y) > r)
+        anchors = anchors_of(v, self.plan, self.room, self.walls, self.sym, half)
+        return Request(self.room, self.walls, self.plan.categories[k], self.plan.symmetry[k], anchors, self.grid,
+                       mask), pk
+
+    def propose(self, k: int):
+        """A candidate box and pose for object ``k``, or None when no allowed candidate has mass."""
+        inst = self.model_for(k)
+        req, pk = self.request(k, inst)
+        drawn = self.proposer.pose(req, self.rng)
+        if drawn is None:
             return None
-        p = self.proposer.density(self.room, self.walls, cat, anchors, self.grid.points) * mask
-        if not np.isfinite(p).all() or p.sum() <= 0:
-            p = mask.astype(float)
-        cell = self.rng.choice(len(p), p=p / p.sum())
-        xy = self.grid.points[cell] + self.rng.uniform(-0.5, 0.5, 2) * self.grid.mpp
-        if yaw is None and self.poses is not None:  # a learned rule first: no network call where one applies
-            yaw = self.poses.yaw(self.room, cat, anchors, xy)
-        if yaw is None:
-            yaw = self.proposer.orientation(self.room, self.walls, cat, sym, xy, self.rng)
+        xy, yaw = drawn
         support = None if pk is None else float(self.room.boxes[pk, 2] + self.room.boxes[pk, 5])
         box, _ = place(inst, xy[0], xy[1], support, yaw)
-        box = snap(box, anchors, self.room, self.gaps, self.cfg["snap"]["reach"])
-        if pk is None:
+        box = snap(box, req.anchors, self.room, self.walls, self.checker.extract_cfg, self.cfg["snap"])
+        if pk is None and self.cfg["snap"]["enabled"]:
             box = inside_walls(box, self.walls, self.cfg["snap"]["gap"], self.cfg["snap"]["reach"])
         box, pose = place(inst, box[0], box[1], support, yaw)
         return xy, box, pose, inst.model_id, pk
@@ -312,19 +296,17 @@ class Search:
         v = self.plan.ids[k]
         culprits: set[str] = set()
         budget = max(self.cfg["min_samples"], self.cfg["samples"] - self.backtracks // 5)
-        half = min(self.cfg["reject_half"] * self.cfg["reject_growth"] ** self.backtracks, self.cfg["reject_max_half"])
-        tol = tolerance(self.backtracks, self.cfg["max_backtracks"])
+        tol = self.tolerance(v)
         blocked = self.nowhere(k, tol)
         if blocked is not None:
             log.debug("%s %s: no free cell in every planned band", self.plan.scene_id, v)
-            self.failures["nowhere"] = self.failures.get("nowhere", 0) + 1
-            self.refusals.setdefault(v, Counter())["nowhere"] += 1
+            self.refuse(v, "nowhere")
             return blocked
         best = None  # with relaxed relations: the cheapest acceptable candidate so far (room, verdict)
         for _ in range(budget):
             if self.candidates >= self.cfg["candidate_budget"]:
                 break
-            cand = self.propose(k, half)
+            cand = self.propose(k)
             if cand is None:  # no free cell left for it (not a rejection: no candidate was drawn)
                 self.refusals.setdefault(v, Counter())["no_cell"] += 1
                 break
@@ -335,24 +317,37 @@ class Search:
             verdict = check(room, len(room.object_ids) - 1, None if pk is None else pk, set(),
                             planned_edges(v, self.plan, present), tol, self.checker)
             if verdict.ok and (verdict.cost == 0 or not self.cfg["keep_relations"]):
-                return self.accept(room, verdict)
+                return self.accept(k, room, verdict, tol)
             if verdict.ok:
                 best = min(best or (room, verdict), (room, verdict), key=lambda rv: rv[1].cost)
                 continue
             self.rejections += 1
             log.debug("%s %s (%s) at %.2f, %.2f: %s", self.plan.scene_id, v, self.plan.categories[k], box[0], box[1], verdict.reason)
-            kind = verdict.reason.split(" ")[0]
-            self.failures[kind] = self.failures.get(kind, 0) + 1
-            self.refusals.setdefault(v, Counter())[kind] += 1
-            self.rejected.setdefault(v, []).append((float(xy[0]), float(xy[1])))
+            self.refuse(v, verdict.reason.split(" ")[0])
+            self.rejected.setdefault(v, []).append((float(xy[0]), float(xy[1]), self.reject_half(v, box[3:5])))
             culprits |= verdict.culprits
-        return culprits if best is None else self.accept(*best)
+        return culprits if best is None else self.accept(k, *best, tol)
 
-    def accept(self, room: RoomInput, verdict) -> None:
-        """Keep a candidate's room and the costs of its planned relations (the edges' loss records)."""
+    def refuse(self, v: str, kind: str) -> None:
+        """Count a refusal of object ``v`` by check ``kind``."""
+        self.failures[kind] = self.failures.get(kind, 0) + 1
+        self.refusals.setdefault(v, Counter())[kind] += 1
+
+    def accept(self, k: int, room: RoomInput, verdict, tol: float) -> None:
+        """Keep a candidate's room and the costs of its planned relations (the edges' loss records); an object kept
+        with a broken relation is recorded with the edges it broke, what extraction found instead, and why it was
+        allowed to (its failures and tolerance, and the check that refused it most)."""
+        v = self.plan.ids[k]
         self.room = room
         self.insertions += 1
         self.accepted.update(verdict.edge_costs)
+        self.relaxed.pop(v, None)
+        if verdict.cost > 0:
+            refused = self.refusals.get(v)
+            self.relaxed[v] = {"id": v, "category": self.plan.categories[k], "cost": round(verdict.cost, 3),
+                               "tolerance": round(tol, 3), "failures": int(self.strikes[v]),
+                               "cause": refused.most_common(1)[0][0] if refused else None,
+                               "broken": [broken(e, verdict.found) for e, c in verdict.edge_costs if c > 0]}
         return None
 
     def drop(self, k: int, cause: str) -> None:
@@ -387,6 +382,9 @@ class Search:
             if culprits is None:
                 i += 1
                 continue
+            self.strikes[self.plan.ids[k]] += 1
+            if self.cfg["redraw"]:  # another instance next time: a size that failed is not forced on it again
+                self.shared.pop(self.model_key(k), None)
             if self.candidates >= self.cfg["candidate_budget"]:
                 return f"candidate budget ({self.cfg['candidate_budget']}) spent at object {i + 1} of {len(self.order)}"
             if self.backtracks >= self.cfg["max_backtracks"]:
@@ -395,13 +393,30 @@ class Search:
                     i += 1
                     continue
                 self.exhausted = True
-                return f"backtrack budget ({self.cfg['max_backtracks']}) spent: no place for {self.plan.ids[k]} ({self.plan.categories[k]})"
+                return self.exhausted_reason(k)
             i = self.backtrack(i, culprits)
         return ""
 
+    def exhausted_reason(self, k: int) -> str:
+        """Why a scene failed when its backtrack budget ran out: the object with no place and the check that refused
+        its candidates most."""
+        v = self.plan.ids[k]
+        refused = self.refusals.get(v)
+        why = f"; refused most by {refused.most_common(1)[0][0]}" if refused else ""
+        return f"backtrack budget ({self.cfg['max_backtracks']}) spent: no place for {v} ({self.plan.categories[k]}){why}"
+
+    def unit_start(self, i: int, j: int) -> int:
+        """Where object ``order[i]``'s failure backtracks to when it blames ``order[j]``: the first member of their
+        chain when both are in one (the chain moves as a unit, not member by member), else ``j``."""
+        unit = self.unit.get(self.order[i])
+        if unit is None or self.unit.get(self.order[j]) != unit:
+            return j
+        return next(m for m in range(i) if self.unit.get(self.order[m]) == unit)
+
     def backtrack(self, i: int, culprits: set[str]) -> int:
-        """Undo back to the latest placed culprit of object ``order[i]``'s failures (else the object before it),
-        rejecting that object's place; returns the position to go on from."""
+        """Undo back to the latest placed culprit of object ``order[i]``'s failures (else the object before it; a
+        culprit in its own chain: the chain's first member), rejecting that object's place; returns the position to
+        go on from."""
         self.backtracks += 1
         if i == 0:  # nothing to undo: the first object tries again afresh
             self.rejected.pop(self.plan.ids[self.order[0]], None)
@@ -409,13 +424,24 @@ class Search:
         placed = [self.plan.ids[j] for j in self.order[:i]]
         earlier = [placed.index(c) for c in culprits if c in placed]
         j = max(earlier) if earlier else i - 1
+        j = self.unit_start(i, j)
         u = self.plan.ids[self.order[j]]
         uk = self.room.object_ids.index(u)
-        self.rejected.setdefault(u, []).append(tuple(map(float, self.room.boxes[uk, :2])))
+        self.rejected.setdefault(u, []).append((*map(float, self.room.boxes[uk, :2]), self.culprit_half(u, i)))
         for later in self.order[j + 1:]:
             self.rejected.pop(self.plan.ids[later], None)
+            self.relaxed.pop(self.plan.ids[later], None)
+        self.relaxed.pop(u, None)
         self.room = with_objects(self.room, np.arange(self.fixed + j))
         return j
+
+
+def broken(edge, found: dict) -> dict:
+    """A broken planned edge as a record: its ends, what was planned and what extraction found instead."""
+    got = [g for g in found.get((edge.source, edge.target), []) if g[0] == edge.edge_type]
+    return {"source": edge.source, "target": edge.target,
+            "planned": "support" if edge.edge_type == "support" else f"{edge.direction}/{edge.distance}",
+            "found": ", ".join("support" if g[0] == "support" else f"{g[1]}/{g[2]}" for g in got) or "absent"}
 
 
 def drop_reason(drops: list[dict], planned: int) -> str:
@@ -426,15 +452,15 @@ def drop_reason(drops: list[dict], planned: int) -> str:
 
 
 def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, pool: ModelPool,
-                checker: Checker, cfg: dict, seed: int, poses: PoseRules | None = None) -> Outcome:
-    """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed); a floor
-    object's orientation follows the learned ``poses`` where one applies, else the proposer's. A search that
-    spends its backtrack budget starts over, up to ``cfg['restarts']`` times: attempt ``a > 0`` draws from
-    ``(seed, a)``, so the first attempt is the search without restarts. Counts and seconds add up over attempts."""
+                checker: Checker, cfg: dict, seed: int) -> Outcome:
+    """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed), each with
+    the pose the proposer gives it. A search that spends its backtrack budget starts over, up to
+    ``cfg['restarts']`` times: attempt ``a > 0`` draws from ``(seed, a)``, so the first attempt is the search without
+    restarts. Counts and seconds add up over attempts."""
     start, runs = time.perf_counter(), []
     for attempt in range(cfg["restarts"] + 1):
         s = Search(plan, room, walls, order, proposer, pool, checker, cfg,
-                   np.random.default_rng(seed if attempt == 0 else [seed, attempt]), poses)
+                   np.random.default_rng(seed if attempt == 0 else [seed, attempt]))
         reason = s.run(time.perf_counter() + cfg["time_budget"])
         runs.append(s)
         if not s.exhausted:
@@ -445,4 +471,5 @@ def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int]
     total = lambda name: sum(getattr(r, name) for r in runs)
     failures = sum((Counter(r.failures) for r in runs), Counter())
     return Outcome(ok, s.room, reason, time.perf_counter() - start, total("insertions"), total("rejections"),
-                   total("backtracks"), dict(failures), s.dropped, s.drops, len(runs), s.accepted)
+                   total("backtracks"), dict(failures), s.dropped, s.drops, len(runs), s.accepted,
+                   [s.relaxed[v] for v in s.room.object_ids if v in s.relaxed])

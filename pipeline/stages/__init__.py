@@ -117,7 +117,9 @@ _ALL = [
                   Param("keep", int, help="objects kept where they are (the first of the placement order)")),
           threads=True),
     Stage("table3", "Gather the variants' summaries of one room type into PlanIT's Table 3 (CSV and HTML).",
-          inputs=(many("summaries", "one per variant"),),
+          inputs=(many("summaries", "one per variant"),
+                  many("nets", "the training summaries of the networks the variants read (held-out pose log-likelihood)",
+                       True)),
           outputs=(one("table"), one("table_html", "the table as a sortable HTML table"))),
     Stage("evaluate", "Score every method's rooms and the held-out real rooms of one room type with the same "
           "metrics.", inputs=(many("summaries", "one per generated set (its name: the summary's method)"),
@@ -140,6 +142,11 @@ _ALL = [
     Stage("energy_trace", "The annealing methods' energy traces (the first scene of each method) of one room type.",
           inputs=(many("generated_scenes", "one per annealing method"), many("summaries", "the same methods' summaries")),
           outputs=(one("figure", "energy and hard violations over the steps (PNG)"),), params=(ROOM_TYPE,)),
+    Stage("export_rooms", "A method's generated rooms of one room type in one format other tools load (usd, procthor "
+          "or front3d; docs/formats.md), as one archive.",
+          inputs=(one("rooms"), one("architecture"), one("objects"), one("models")),
+          outputs=(one("archive", "zip archive of the exported files and export.json"),),
+          params=(ROOM_TYPE, METHOD, Param("format", help="usd | procthor | front3d"))),
     Stage("runtime", "Job seconds and peak memory per rule from the benchmark files, and the run's wall-clock span.",
           inputs=(many("corpus", "the corpus stages' outputs (their jobs are timed; read for their presence)"),
                   many("learned", "the learned room types' outputs (likewise)")),

@@ -19,23 +19,40 @@ from ...log import progress
 from ...placement import order, proposers
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
-from ...placement.search import instantiate
+from ...placement.search import SCORED, instantiate
 from ..interface import Corpus, Scene, Task
 from ..placing import Context, load_context, scene_of
+from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from .nets.proposer import NetProposer
 from .nets.train import KIND
 
 log = logging.getLogger("planit.instantiate")
 
 
-def make_proposer(location: str, saved, cfg: dict):
-    """The variant's proposer: network densities (weighted by the relation bands when ``relation_mask``), uniform or
-    rule-band locations; orientations from the network. ``cfg``: the instantiate section."""
+def make_proposer(location: str, saved, cfg: dict, extract: dict):
+    """The variant's proposer (``cfg``: its instantiate settings, ``extract``: the extraction's): the pose networks
+    (their densities weighted by the relation bands when ``relation_mask``), the relative-pose prior (likewise), or
+    uniform or rule-band locations with the networks' orientations."""
+    bands = proposers.RelationPrior(extract, soft=cfg["band_softness"], slack=cfg["band_slack"])
+    if location == "prior":
+        return PosePrior.from_record(saved.record, bands if cfg["relation_mask"] else None)
     nets = NetProposer(saved, cfg["density_cache"], film=location == "cfcn")
     if location in ("cfcn", "fcn"):
-        bands = proposers.RelationPrior(soft=cfg["band_softness"])
         return proposers.Masked(nets, bands) if cfg["relation_mask"] else nets
-    return proposers.Combined(proposers.UniformLocation() if location == "random" else proposers.RelationPrior(), nets)
+    return proposers.Combined(proposers.UniformLocation() if location == "random" else bands, nets)
+
+
+def search_settings(ic: dict, variant: dict) -> dict:
+    """The instantiate settings a variant searches with: its own ``search`` values over the section's."""
+    own = variant.get("search", {})
+    out = {**ic, **{k: v for k, v in own.items() if k != "snap"}}
+    if "snap" in own:
+        out["snap"] = {**ic["snap"], "enabled": own["snap"]}
+    return out
+
+
+def checkpoint_kind(location: str) -> str:
+    return PRIOR_KIND if location == "prior" else KIND
 
 
 def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dict, seed: int, keep: int = 0):
@@ -50,7 +67,7 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
     fixed = [plan.ids[k] for k in seq[:keep]]
     start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
     walls = walls_of(start)
-    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.pool, ctx.checker, cfg, seed, ctx.poses), walls
+    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.pool, ctx.checker, cfg, seed), walls
 
 
 def select_plans(config: dict, variant: dict, corpus: Corpus, nodes: Path, edges: Path, count: int) -> list[ScenePlan]:
@@ -81,21 +98,28 @@ class PlanitLayout:
         if name not in ic["variants"]:
             raise InputError(f"'{name}' is not in instantiate.variants ({', '.join(ic['variants'])})")
         self.config, self.name, self.variant = config, name, ic["variants"][name]
+        self.settings = search_settings(ic, self.variant)
         self.info = dict(self.variant)
 
     def generate(self, task: Task) -> Iterator[Scene]:
         torch.set_num_threads(task.threads)
-        saved = checkpoint.load(task.model, KIND)
+        saved = checkpoint.load(task.model, checkpoint_kind(self.variant["location"]))
         ctx = load_context(self.config, task.corpus)
-        plans = select_plans(self.config, self.variant, task.corpus, *task.graphs,
-                             task.count or scene_count(self.config["instantiate"], self.variant))
+        count = task.count or scene_count(self.config["instantiate"], self.variant)
+        draws = self.settings["graph_draws"] if self.variant["graphs"] == "sampled" else 1
+        plans = select_plans(self.config, self.variant, task.corpus, *task.graphs, count * draws)
         if not plans:
             log.warning("%s: no graph of room type '%s' to place: writing empty tables", task.graphs[0],
                         task.corpus.room_type)
-        proposer = make_proposer(self.variant["location"], saved, self.config["instantiate"])
-        for plan in progress(plans, total=len(plans), desc=f"instantiate {task.corpus.room_type} ({self.name})"):
+        proposer = make_proposer(self.variant["location"], saved, self.settings, self.config["extract"])
+        scored, bar = 0, iter(progress(range(count), desc=f"instantiate {task.corpus.room_type} ({self.name})"))
+        for plan in plans:
+            if scored >= count:
+                break
             seed = zlib.crc32(f"{self.config['seed']}/{self.name}/{plan.scene_id}".encode())
-            outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed)
+            outcome, walls = place_scene(plan, ctx, proposer, self.settings, self.variant, seed)
+            scored += outcome.status in SCORED
+            next(bar, None) if outcome.status in SCORED else None
             yield scene_of(plan, ctx, outcome, walls)
 
 
@@ -120,7 +144,7 @@ class CompleteRoom:
             raise InputError(f"keep: {self.keep}, but room {self.room} has {len(plan.ids)} objects")
         saved = checkpoint.load(task.model, KIND)
         ctx = load_context(self.config, task.corpus)
-        proposer = make_proposer("cfcn", saved, self.config["instantiate"])
+        proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"])
         seed = zlib.crc32(f"{self.config['seed']}/complete/{plan.scene_id}".encode())
         outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)
         yield scene_of(plan, ctx, outcome, walls)

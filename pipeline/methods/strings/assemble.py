@@ -25,7 +25,9 @@ from ...placement.checks import Checker, check
 from ...placement.layout import add_object, walls_of
 from ...placement.plan import PlanEdge, ScenePlan
 from ...placement.retrieval import ModelPool, place
-from ...placement.search import Grid, Outcome, anchors_of, drop_reason, inside_walls, planned_edges, snap
+from ...placement.anchors import anchors_of, planned_edges
+from ...placement.proposers import Grid
+from ...placement.search import Outcome, drop_reason, inside_walls, snap
 from ...room import RoomInput, Walls
 from .poses import anchor_frame, from_relative
 
@@ -90,7 +92,10 @@ def pose_of(p: Placing, tag: Tag, room: RoomInput, walls: Walls) -> tuple[np.nda
     pose = tag[0]
     if p.forward:
         frame = anchor_frame(p.edge.source, room, walls)
-        return None if frame is None else from_relative(*frame, pose)
+        if frame is None:
+            return None
+        xy, yaw = from_relative(*frame, pose)
+        return xy[0], float(yaw[0])
     other = anchor_frame(p.edge.target, room, walls)
     if other is None:
         return None
@@ -106,7 +111,6 @@ class Assembly:
                  cfg: dict, icfg: dict, rng: np.random.Generator):
         self.plan, self.room, self.walls, self.tags, self.pool, self.checker = plan, room, walls, tags, pool, checker
         self.cfg, self.rng, self.snap_cfg, self.mpp = cfg, rng, icfg["snap"], icfg["grid_mpp"]
-        self.gaps = {"adjacent": (self.snap_cfg["gap"],) * 2, "proximal": tuple(self.snap_cfg["proximal"])}
         self.sym = dict(zip(plan.ids, plan.symmetry))
         self.insertions = self.rejections = self.unanchored = 0
         self.failures: dict[str, int] = {}
@@ -136,8 +140,8 @@ class Assembly:
         pk = self.room.object_ids.index(parent) if parent in self.room.object_ids else None
         support = None if pk is None else float(self.room.boxes[pk, 2] + self.room.boxes[pk, 5])
         box, _ = place(inst, xy[0], xy[1], support, yaw)
-        box = snap(box, anchors_of(v, self.plan, self.room, self.walls, self.sym, inst.half[:2]), self.room, self.gaps,
-                   self.snap_cfg["reach"])
+        box = snap(box, anchors_of(v, self.plan, self.room, self.walls, self.sym, inst.half[:2]), self.room, self.walls,
+                   self.checker.extract_cfg, self.snap_cfg)
         if pk is None:
             box = inside_walls(box, self.walls, self.snap_cfg["gap"], self.snap_cfg["reach"])
         return place(inst, box[0], box[1], support, yaw)

@@ -15,9 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...geometry.frames import Frame, boxes_to_local
 from ...graphs.data import EDGE_CLASSES, N_OBJECT_EDGES, Graph, Vocab
-from ...placement.layout import box_frame, wall_frame
+from ...placement.prior import anchor_frame, from_relative, relative_pose  # noqa: F401 (from_relative: assemble's)
 from ...room import RoomInput, Walls
 
 Triple = tuple[str, str, int]  # anchor class name, target category, edge class
@@ -32,32 +31,6 @@ class EdgePose:
     edge_class: int
     triple: Triple
     pose: np.ndarray
-
-
-def anchor_frame(node_id: str, room: RoomInput, walls: Walls) -> tuple[Frame, float] | None:
-    """The frame of an anchor node (an object or a wall of ``room``) and the scale of its x (a wall's half length;
-    1 for an object); None for other nodes (doors, windows)."""
-    if node_id in room.object_ids:
-        return box_frame(room.boxes[room.object_ids.index(node_id)]), 1.0
-    if node_id in walls.ids:
-        w = walls.ids.index(node_id)
-        return wall_frame(walls, w), float(walls.length[w]) / 2
-    return None
-
-
-def relative_pose(frame: Frame, scale: float, box: np.ndarray) -> np.ndarray:
-    """``(3,)`` x / scale, y, yaw of ``box (7,)`` in ``frame``."""
-    local = boxes_to_local(frame, box)[0]
-    return np.array([local[0] / scale, local[1], local[6]])
-
-
-def from_relative(frame: Frame, scale: float, pose: np.ndarray) -> tuple[np.ndarray, float]:
-    """The world centre ``(2,)`` and yaw of a relative ``pose (3,)`` in ``frame`` (the inverse of
-    :func:`relative_pose` on the centre and yaw)."""
-    c, s = np.cos(frame.yaw), np.sin(frame.yaw)
-    x, y = pose[0] * scale, pose[1]
-    xy = np.array([frame.origin[0] + c * x - s * y, frame.origin[1] + s * x + c * y])
-    return xy, float((frame.yaw + pose[2] + np.pi) % (2 * np.pi) - np.pi)
 
 
 def edge_poses(graph: Graph, vocab: Vocab, room: RoomInput, walls: Walls) -> list[EdgePose]:

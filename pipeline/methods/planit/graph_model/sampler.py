@@ -211,8 +211,8 @@ def _seen_mask(st: _State, graphs, present, new, width) -> torch.Tensor:
 
 
 def _order_mask(st: _State, graphs, width) -> torch.Tensor:
-    """``(G, width, 26)`` choices that would break what real graphs never break: a directed cycle among objects, or
-    a second support parent."""
+    """``(G, width, 26)`` choices that would break what real graphs never break: a directed cycle among objects, a
+    second support parent, or a second edge between the same two nodes (a final graph joins a pair once)."""
     mask = torch.zeros(len(graphs), width, 2, N_OBJECT_EDGES, dtype=torch.bool)
     for r, b in enumerate(graphs.tolist()):
         g = st.grown[b]
@@ -236,6 +236,10 @@ def _order_mask(st: _State, graphs, width) -> torch.Tensor:
             mask[r, u, 0, :] = True  # u -> me would close a cycle
         for u in up - {me}:
             mask[r, u, 1, :] = True  # me -> u would close a cycle
+        for s, t, c in g.edges:  # a pair already joined: no second edge either way
+            u = s if t == me else t if s == me else None
+            if u is not None and u < width:
+                mask[r, u] = True
         if me in has_parent:
             mask[r, :, 0, 0] = True  # me has its support parent
         for u in has_parent:

@@ -1,6 +1,6 @@
-"""Fit PlanIT's placement networks (location CFCN + orientation) of one room type on its training rooms (fit and
-validation splits; the held-out rooms are never trained on); ``net="fcn"`` trains the unconditional FCN of the
-ablation."""
+"""Fit PlanIT's pose networks (location CFCN + orientation) of one room type on its training rooms (fit and
+validation splits; the held-out rooms are never trained on); ``net="fcn"`` trains the unconditional pair of the
+ablation (no FiLM in either)."""
 from __future__ import annotations
 
 import logging
@@ -20,6 +20,7 @@ from .data import TrainingRoom, training_room
 
 log = logging.getLogger("planit.train_placement")
 NETS = ("cfcn", "fcn")
+LOGLIK = ("heldout_location_loglik", "heldout_orientation_loglik", "heldout_pose_loglik")
 
 
 def training_rooms(inputs: dict, node_df: pd.DataFrame, edge_df: pd.DataFrame, split: dict[str, str]):
@@ -45,18 +46,20 @@ def fit_room_type(config: dict, room_type: str, net: str, cats: tuple, train_roo
     preset = pc["presets"][pc["preset"]]
     torch.set_num_threads(threads)
     device = pick_device(pc["device"])
-    chash = config_hash({"preset": preset, "net": net, "seed": config["seed"], "room_type": room_type,
+    data = {"snap_angle": pc["snap_angle"], "none_share": pc["none_share"]}
+    chash = config_hash({"preset": preset, "net": net, "seed": config["seed"], "room_type": room_type, **data,
                          "rooms": sorted(t.room.room_id for t in train_rooms), "categories": cats})
     nets, history = nets_train.train(train_rooms, held_rooms, cats, preset, net == "cfcn", config["seed"],
-                                     progress_file, chash, device, _ticker(room_type, net, preset))
+                                     progress_file, chash, device, _ticker(room_type, net, preset), data)
     ckpt = Checkpoint(nets_train.KIND, chash, {"nets": [n.cpu().state_dict() for n in nets]}, {
-        "room_type": room_type, "net": net, "categories": list(cats), "preset": preset, "heldout_ids": held_ids})
+        "room_type": room_type, "net": net, "categories": list(cats), "preset": preset, "heldout_ids": held_ids, **data})
     frame = pd.DataFrame(history)
     summary = {"room_type": room_type, "net": net, "preset": pc["preset"], "device": device,
                "train_rooms": len(train_rooms), "heldout_rooms": len(held_rooms), "steps": int(frame["step"].iloc[-1]),
                "train_seconds": round(float(frame["seconds"].iloc[-1]), 1),
                "final_heldout_location_loss": round(float(frame["heldout_location_loss"].iloc[-1]), 4),
-               "final_heldout_orientation_loss": round(float(frame["heldout_orientation_loss"].iloc[-1]), 4)}
+               "final_heldout_orientation_loss": round(float(frame["heldout_orientation_loss"].iloc[-1]), 4),
+               **{k: round(float(frame[k].iloc[-1]), 4) for k in LOGLIK}}
     return Fitted(ckpt, frame, summary, _curve(frame, room_type, net))
 
 
@@ -83,11 +86,15 @@ def _curve(history, room_type: str, net: str):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.2))
     for ax, name in zip(axes, ("location", "orientation")):
         ax.plot(history["step"], history[f"{name}_loss"], label="train")
         ax.plot(history["step"], history[f"heldout_{name}_loss"], label="held-out")
         ax.set(xlabel="step", ylabel="loss", title=f"{name}, {room_type} ({net})")
         ax.legend()
+    for k in LOGLIK:
+        axes[2].plot(history["step"], history[k], label=k.replace("heldout_", "").replace("_loglik", ""))
+    axes[2].set(xlabel="step", ylabel="nats per example", title="held-out log-likelihood of the true pose")
+    axes[2].legend()
     fig.tight_layout()
     return fig

@@ -3,18 +3,22 @@
 :class:`LocationNet` is the conditional FCN: a residual encoder (ResNet-34's layout in the paper preset), then
 upsampling blocks of conv - BatchNorm - FiLM - LeakyReLU with CoordConv (two coordinate channels concatenated) and
 skips from the encoder, predicting per pixel a distribution over every category plus background at once. FiLM
-scales and shifts every decoder block from an embedding of the edge: direction, distance, and whether the anchor is
-a wall. Without FiLM (``film=False``) it is the unconditional FCN of the ablation.
+scales and shifts every decoder block from an embedding of the planned edge (:data:`~.data.EDGE_KINDS`: direction
+and distance, support, or none), whether the anchor is a wall and whether the edge runs from the target to the
+anchor. Without FiLM (``film=False``) it is the unconditional FCN of the ablation.
 
-:class:`OrientationNet` reads a crop around a location and gives, per category, logits over ``bins`` yaws in the
-nearest wall's frame (a documented simpler choice than the paper's CVAE: the bins include the wall-aligned
-directions, so snapping comes for free).
+:class:`OrientationNet` reads a crop centred on a location, turned like the anchor's frame, and gives per category
+logits over ``bins`` yaws relative to that frame plus one logit of standing square to the nearest wall (the paper's
+snap classifier); FiLM scales and shifts its encoder from the same edge embedding and the location's position in the
+anchor's frame (a documented simpler choice than the paper's CVAE: binned yaws).
 """
 from __future__ import annotations
 
 import torch
 from torch import nn
 from torch.nn import functional as F
+
+from .data import EDGE_KINDS
 
 
 def coords(x: torch.Tensor) -> torch.Tensor:
@@ -63,8 +67,8 @@ class LocationNet(nn.Module):
         self.up = nn.ModuleList(ups)
         self.norm = nn.ModuleList(nn.BatchNorm2d(s) for s in skips)
         self.head = nn.Conv2d(c, categories + 1, 1)
-        self.embed = nn.ModuleList([nn.Embedding(4, embed), nn.Embedding(3, embed), nn.Embedding(2, embed)])
-        self.gamma_beta = nn.Linear(3 * embed, 2 * sum(skips))
+        self.embed = Condition(embed)
+        self.gamma_beta = nn.Linear(self.embed.size, 2 * sum(skips))
         self.sizes = skips
 
     def forward(self, image: torch.Tensor, cond: torch.Tensor) -> torch.Tensor:
@@ -74,7 +78,7 @@ class LocationNet(nn.Module):
         for stage in self.down:
             x = stage(x)
             feats.append(x)
-        gb = self.gamma_beta(torch.cat([e(cond[:, k]) for k, e in enumerate(self.embed)], 1))
+        gb = self.gamma_beta(self.embed(cond))
         offset = 0
         for k, (conv, norm, size) in enumerate(zip(self.up, self.norm, self.sizes)):
             skip = feats[-2 - k]
@@ -89,18 +93,42 @@ class LocationNet(nn.Module):
 
 
 class OrientationNet(nn.Module):
-    def __init__(self, channels: int, categories: int, bins: int, widths: list[int]):
+    def __init__(self, channels: int, categories: int, bins: int, widths: list[int], film: bool = True, embed: int = 16):
         super().__init__()
+        self.film = film
         self.down = encoder(channels + 2, widths, [1] * len(widths))
-        self.head = nn.Linear(widths[-1], categories * bins)
-        self.categories, self.bins = categories, bins
+        self.embed = Condition(embed, extra=2)
+        self.gamma_beta = nn.Linear(self.embed.size, 2 * sum(widths))
+        self.head = nn.Linear(widths[-1], categories * (bins + 1))
+        self.categories, self.bins, self.widths = categories, bins, widths
 
-    def forward(self, image: torch.Tensor) -> torch.Tensor:
-        """``(n, C, s, s)`` crops -> ``(n, categories, bins)`` logits."""
+    def forward(self, image: torch.Tensor, cond: torch.Tensor, rel: torch.Tensor) -> torch.Tensor:
+        """``(n, C, s, s)`` crops, ``(n, 3)`` conditions and ``(n, 2)`` positions in the anchor's frame ->
+        ``(n, categories, bins + 1)`` logits (yaw bins, then standing square to the nearest wall)."""
         x = coords(image)
-        for stage in self.down:
+        gb = self.gamma_beta(self.embed(cond, rel)) if self.film else None
+        offset = 0
+        for stage, width in zip(self.down, self.widths):
             x = stage(x)
-        return self.head(x.mean((2, 3))).view(-1, self.categories, self.bins)
+            if gb is not None:
+                g, b = gb[:, offset:offset + width], gb[:, offset + width:offset + 2 * width]
+                x = x * (1 + g[:, :, None, None]) + b[:, :, None, None]
+            offset += 2 * width
+        return self.head(x.mean((2, 3))).view(-1, self.categories, self.bins + 1)
+
+
+class Condition(nn.Module):
+    """The embedding of a planned edge: its kind, wall anchor and reverse flags (``cond (n, 3)``), concatenated
+    with ``extra`` continuous features."""
+
+    def __init__(self, embed: int, extra: int = 0):
+        super().__init__()
+        self.parts = nn.ModuleList([nn.Embedding(len(EDGE_KINDS), embed), nn.Embedding(2, embed), nn.Embedding(2, embed)])
+        self.size = 3 * embed + extra
+
+    def forward(self, cond: torch.Tensor, extra: torch.Tensor | None = None) -> torch.Tensor:
+        parts = [e(cond[:, k]) for k, e in enumerate(self.parts)]
+        return torch.cat(parts + ([] if extra is None else [extra]), 1)
 
 
 def location_loss(logits: torch.Tensor, cat: torch.Tensor, row: torch.Tensor, col: torch.Tensor,
@@ -115,7 +143,20 @@ def location_loss(logits: torch.Tensor, cat: torch.Tensor, row: torch.Tensor, co
     return F.cross_entropy(logits, target, weight=weights)
 
 
-def orientation_loss(logits: torch.Tensor, cat: torch.Tensor, bins: torch.Tensor) -> torch.Tensor:
-    """``-log`` of the probability of the equivalent bins of the target's yaw."""
-    logp = F.log_softmax(logits[torch.arange(len(cat)), cat], 1)
-    return -(torch.logsumexp(logp.masked_fill(~bins, float("-inf")), 1)).mean()
+def orientation_loss(logits: torch.Tensor, cat: torch.Tensor, bins: torch.Tensor, snap: torch.Tensor) -> torch.Tensor:
+    """``-log`` of the probability of the equivalent bins of the target's yaw, plus the snap bit's cross-entropy."""
+    own = logits[torch.arange(len(cat)), cat]
+    return -bin_loglik(own[:, :-1], bins).mean() + F.binary_cross_entropy_with_logits(own[:, -1], snap.float())
+
+
+def bin_loglik(logits: torch.Tensor, bins: torch.Tensor) -> torch.Tensor:
+    """``(n,)`` log probability of the equivalent bins ``bins (n, b)`` under ``logits (n, b)``."""
+    logp = F.log_softmax(logits, 1)
+    return torch.logsumexp(logp.masked_fill(~bins, float("-inf")), 1)
+
+
+def location_loglik(logits: torch.Tensor, cat: torch.Tensor, row: torch.Tensor, col: torch.Tensor) -> torch.Tensor:
+    """``(n,)`` log probability of the target's pixel under its category's map normalised over the view (the density
+    the search draws from)."""
+    p = torch.softmax(logits, 1)[torch.arange(len(cat)), cat + 1]  # (n, h, w)
+    return torch.log(p[torch.arange(len(cat)), row, col] / p.sum((1, 2)).clamp_min(1e-12) + 1e-12)

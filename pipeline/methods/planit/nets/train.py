@@ -2,7 +2,8 @@
 
 Batches come from ``(seed, step)`` alone, so a run resumed from its checkpoint (written atomically every
 ``checkpoint_every`` steps, carrying the config hash) continues exactly as an uninterrupted one. Every
-``log_every`` steps the losses on a fixed batch of held-out rooms are logged.
+``log_every`` steps the losses and the log-likelihood of the true pose (location pixel and yaw bins, nats per
+example) on a fixed set of held-out examples (``heldout_examples``) are logged.
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import torch
 from ....learning import checkpoint as ckpt
 from ....placement.layout import View
 from .data import TrainingRoom, batch
-from .model import LocationNet, OrientationNet, location_loss, orientation_loss
+from .model import LocationNet, OrientationNet, bin_loglik, location_loglik, location_loss, orientation_loss
 
 KIND, PROGRESS = "placement_nets", "placement_nets.progress"  # checkpoint kinds
 log = logging.getLogger("planit.placement")
@@ -29,7 +30,7 @@ def views(preset: dict, categories: tuple[str, ...]) -> tuple[View, View]:
 def build(preset: dict, categories: tuple[str, ...], film: bool) -> tuple[LocationNet, OrientationNet]:
     loc_view, ori_view = views(preset, categories)
     return (LocationNet(loc_view.channels, len(categories), preset["widths"], preset["blocks"], film),
-            OrientationNet(ori_view.channels, len(categories), preset["bins"], preset["crop_widths"]))
+            OrientationNet(ori_view.channels, len(categories), preset["bins"], preset["crop_widths"], film))
 
 
 def _tensors(b: dict, device: str) -> dict:
@@ -39,18 +40,32 @@ def _tensors(b: dict, device: str) -> dict:
 def _losses(nets, b: dict, weight: float) -> tuple[torch.Tensor, torch.Tensor]:
     loc, ori = nets
     return (location_loss(loc(b["loc"], b["cond"]), b["cat"], b["row"], b["col"], weight),
-            orientation_loss(ori(b["ori"]), b["cat"], b["bins"]))
+            orientation_loss(ori(b["ori"], b["cond"], b["rel"]), b["cat"], b["bins"], b["snap"]))
+
+
+def pose_loglik(nets, b: dict) -> dict:
+    """Mean log-likelihood (nats per example) of the true location pixel and of the true yaw's bins under the
+    networks, on batch ``b``."""
+    loc, ori = nets
+    with torch.no_grad():
+        where = location_loglik(loc(b["loc"], b["cond"]), b["cat"], b["row"], b["col"])
+        own = ori(b["ori"], b["cond"], b["rel"])[torch.arange(len(b["cat"])), b["cat"]]
+        turn = bin_loglik(own[:, :-1], b["bins"])
+    return {"heldout_location_loglik": float(where.mean()), "heldout_orientation_loglik": float(turn.mean()),
+            "heldout_pose_loglik": float((where + turn).mean())}
 
 
 def train(rooms: list[TrainingRoom], held: list[TrainingRoom], categories: tuple[str, ...], preset: dict, film: bool,
-          seed: int, checkpoint: Path, config_hash: str, device: str = "cpu", progress=None):
-    """Train for ``preset['steps']`` steps; returns the two networks (eval mode) and the history rows."""
+          seed: int, checkpoint: Path, config_hash: str, device: str = "cpu", progress=None, data: dict | None = None):
+    """Train for ``preset['steps']`` steps; returns the two networks (eval mode) and the history rows. ``data``:
+    ``snap_angle`` (deg) and ``none_share`` of the examples (:func:`~.data.batch`)."""
     torch.manual_seed(seed)
     nets = [n.to(device) for n in build(preset, categories, film)]
     opt = torch.optim.Adam([p for n in nets for p in n.parameters()], lr=preset["lr"])
     loc_view, ori_view = views(preset, categories)
-    draw = lambda pool, s, step: _tensors(batch(pool, s, step, preset["batch_size"], loc_view, ori_view, preset["bins"]), device)
-    fixed = draw(held or rooms, seed + 1, 0)
+    cfg = {"bins": preset["bins"], **(data or {"snap_angle": 5.0, "none_share": 0.1})}
+    draw = lambda pool, s, step, n: _tensors(batch(pool, s, step, n, loc_view, ori_view, cfg), device)
+    fixed = draw(held or rooms, seed + 1, 0, preset["heldout_examples"])
     state = {"step": 0, "history": []}
     saved = ckpt.resume(checkpoint, PROGRESS, config_hash, device)
     if saved is not None:
@@ -64,7 +79,7 @@ def train(rooms: list[TrainingRoom], held: list[TrainingRoom], categories: tuple
         state["step"] += 1
         for n in nets:
             n.train()
-        loc_l, ori_l = _losses(nets, draw(rooms, seed, state["step"]), preset["loss_weight"])
+        loc_l, ori_l = _losses(nets, draw(rooms, seed, state["step"], preset["batch_size"]), preset["loss_weight"])
         opt.zero_grad()
         (loc_l + ori_l).backward()
         opt.step()
@@ -76,7 +91,8 @@ def train(rooms: list[TrainingRoom], held: list[TrainingRoom], categories: tuple
                 h_loc, h_ori = _losses(nets, fixed, preset["loss_weight"])
             row = {"step": state["step"], "location_loss": float(np.mean([w[0] for w in window])),
                    "orientation_loss": float(np.mean([w[1] for w in window])), "heldout_location_loss": float(h_loc),
-                   "heldout_orientation_loss": float(h_ori), "seconds": time.perf_counter() - start}
+                   "heldout_orientation_loss": float(h_ori), **pose_loglik(nets, fixed),
+                   "seconds": time.perf_counter() - start}
             state["history"].append(row)
             window = []
             if progress:
