@@ -40,6 +40,8 @@ browser:
 
 test: setup browser
 	$(BIN)/lint-imports
+	$(BIN)/ruff check pipeline tests bench
+	$(BIN)/mypy
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/python -m pytest -q -ra -n 2 --dist loadgroup
 
 test-slurm: setup

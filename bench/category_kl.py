@@ -18,13 +18,11 @@ import json
 import tempfile
 from pathlib import Path
 
-from pipeline.stage import Files
-from pipeline import config as config_mod
-from pipeline import tables
-from pipeline.evaluation import distributions
-from pipeline.evaluation import scores as evaluate_scores
+from pipeline import config as config_mod, tables
+from pipeline.evaluation import distributions, scores as evaluate_scores
 from pipeline.evaluation.sets import load_real
 from pipeline.graphs.files import read_split
+from pipeline.stage import Files
 from pipeline.stages import sample_graphs
 
 from common import ROOT, arguments, report

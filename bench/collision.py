@@ -21,8 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline import config as config_mod
-from pipeline import tables
+from pipeline import config as config_mod, tables
 from pipeline.corpus.ingest import OUTPUTS
 from pipeline.geometry import boxes, collision, meshes
 from pipeline.geometry.raycast import intersector_class

@@ -6,9 +6,9 @@ import argparse
 import json
 from pathlib import Path
 
+from pipeline import config as config_mod
 from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.stage import Files
-from pipeline import config as config_mod
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "bench" / "out"

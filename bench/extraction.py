@@ -12,10 +12,10 @@ import time
 import warnings
 from pathlib import Path
 
-from pipeline.stage import Files
 from pipeline.extraction import extract_room
 from pipeline.geometry.raycast import intersector_class
 from pipeline.room import room_inputs
+from pipeline.stage import Files
 from pipeline.stages import symmetry
 from pipeline.stages.extract_graphs import load_shard
 

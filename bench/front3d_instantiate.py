@@ -14,11 +14,10 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline import config as config_mod, tables
 from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
-from pipeline.stage import Files
-from pipeline import config as config_mod
-from pipeline import tables
 from pipeline.placement.reinstantiate import own_plans, reinstantiate, summary
+from pipeline.stage import Files
 from pipeline.stages import extract_graphs, ingest, symmetry
 
 from common import OUT, ROOT, arguments, report, search_flags, search_overrides, search_suffix

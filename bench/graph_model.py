@@ -18,12 +18,10 @@ import numpy as np
 import torch
 
 from pipeline import config as config_mod
-from pipeline.graphs import checks as graph_checks
-from pipeline.graphs import data as graph_data
-from pipeline.methods.planit.graph_model import sampler
-from pipeline.methods.planit.graph_model import train
-from pipeline.methods.planit.graph_model.teacher import make_batch, nll
+from pipeline.graphs import checks as graph_checks, data as graph_data
 from pipeline.graphs.files import room_graphs
+from pipeline.methods.planit.graph_model import sampler, train
+from pipeline.methods.planit.graph_model.teacher import make_batch, nll
 
 from common import ROOT, arguments, report
 

@@ -27,19 +27,17 @@ import numpy as np
 import pandas as pd
 import torch
 
-from pipeline import config as config_mod
-from pipeline import tables
-from pipeline.evaluation import functional as functional_checks
-from pipeline.evaluation import physical
+from pipeline import config as config_mod, tables
+from pipeline.evaluation import functional as functional_checks, physical
 from pipeline.evaluation.evaluate import off_axis_gap, off_axis_shares
 from pipeline.geometry.frames import turn_error
 from pipeline.learning import checkpoint
 from pipeline.methods.corpus import load_corpus
+from pipeline.methods.placing import load_context
 from pipeline.methods.planit import layout as instantiate
 from pipeline.methods.planit.nets.fit import training_rooms
 from pipeline.methods.planit.nets.proposer import TURNS, NetProposer
 from pipeline.methods.scenes import plan_loss
-from pipeline.methods.placing import load_context
 from pipeline.placement import scene_metrics
 from pipeline.placement.anchors import anchors_of
 from pipeline.placement.layout import wall_frame, with_objects

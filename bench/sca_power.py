@@ -3,7 +3,7 @@ evaluate stage runs, on a finished run's held-out rooms of one room type, for th
 control and any method's generated rooms. The sweep behind docs/benchmarks.md ("An evaluation that can fail"):
 
     .venv/bin/python bench/sca_power.py RUN TYPE [--steps 1000 --width 16 --stride 2 --lr 0.002] [--mpp 0.1]
-        [--only placement,turns,real_vs_real,planit]
+        [--only placement,turns,real_vs_real,planit] [--mode per_set|shared]
 
 RUN: a run directory (``snakemake --directory RUN``) with results/splits, filter and ingest shards and
 results/generated/<TYPE>/<method>/. ``--mpp``: a fixed m per pixel instead of fitting each room to the window.
@@ -18,7 +18,7 @@ import numpy as np
 
 from pipeline import config as config_mod
 from pipeline.evaluation import power, render
-from pipeline.evaluation.sca import sca
+from pipeline.evaluation.sca import sca, sca_all
 from pipeline.evaluation.sets import generated_sets, load_real
 from pipeline.graphs.files import read_split
 
@@ -29,6 +29,8 @@ def main() -> None:
     ap.add_argument("room_type")
     for key, kind in (("steps", int), ("width", int), ("stride", int), ("lr", float)):
         ap.add_argument(f"--{key}", type=kind)
+    ap.add_argument("--mode", choices=["per_set", "shared"], default="per_set",
+                    help="per_set: a classifier per set, timed one by one; shared: one per fold for all sets")
     ap.add_argument("--mpp", type=float, help="fixed m per pixel (default: each room fitted to the window)")
     ap.add_argument("--only", help="comma-separated set names (default: every power set, the control, every method)")
     args = ap.parse_args()
@@ -41,7 +43,7 @@ def main() -> None:
                             shards("filter/shards/rooms-*.parquet"), shards("ingest/shards/architecture-*.parquet"),
                             shards("ingest/shards/objects-*.parquet"))
     folders = sorted(p for p in (res / "generated" / args.room_type).iterdir() if (p / "scenes.parquet").exists()
-                     and p.name in cfg["generation"]["methods"])
+                     and p.name in cfg["generation"]["methods"] and (not args.only or p.name in args.only.split(",")))
     gen = generated_sets(*([p / n for p in folders] for n in ("summary.json", "rooms.parquet", "architecture.parquet",
                                                               "objects.parquet", "scenes.parquet")))
     index = {c: k for k, c in enumerate(sorted({c for s in (train, real, *gen) for r in s.rooms for c in r.categories}))}
@@ -59,6 +61,15 @@ def main() -> None:
     sets[power.CONTROL] = (train_images[back], np.arange(len(back)), None)
     only = args.only.split(",") if args.only else list(sets)
     print(f"{args.room_type}: {len(train.rooms)} training, {len(real.rooms)} held-out rooms; {sca_cfg}")
+    if args.mode == "shared":  # every set (and the control) in one classifier per fold, as the evaluate stage does
+        start = time.perf_counter()
+        picked = {n: sets[n] for n in only if n != power.CONTROL}
+        outs = sca_all((train_images, real_test), picked, (train_images[kept], sets[power.CONTROL][0], power.CONTROL),
+                       {**sca_cfg, "mode": "shared"}, 1, cfg["seed"])
+        for name, out in outs.items():
+            print(f"{name:24s} {out['accuracy']:6.1f} [{out['low']:.1f}, {out['high']:.1f}] test {out['test']}")
+        print(f"shared: {time.perf_counter() - start:.1f} s for {len(outs)} sets", flush=True)
+        return
     for name in only:
         images, groups, real_groups = sets[name]
         start = time.perf_counter()

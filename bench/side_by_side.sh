@@ -1,8 +1,10 @@
 #!/bin/bash
 # Two commits' workflows timed side by side: each commit in a git worktree of its own (under $TMPDIR, default /tmp),
 # run with this checkout's .venv and PYTHONPATH on the worktree, in a fresh work folder, alternating, ROUNDS times.
-# Prints the wall clock, the jobs and the summed job time (benchmarks/*.tsv) of each run. Run it with nothing else
-# running.
+# Prints the wall clock, the jobs and the summed job time (benchmarks/*.tsv) of each run, then the last round's
+# evaluation tables side by side (bench/compare_metrics.py: each figure of the first commit with its 95% interval, the
+# second's, and whether it moved outside), so a speed-up that changes outcomes is seen. Run it with nothing else
+# running. The default run of two commits: bench/side_by_side.sh A B 1 config/config.yaml all
 #   bench/side_by_side.sh be119c2 692fa75 [ROUNDS=2] [CONFIG=config/tiny.yaml] [TARGETS="all results/generated/bedroom/table3.csv"]
 set -eu
 a=$1; b=$2; rounds=${3:-2}; config=${4:-config/tiny.yaml}; targets=${5:-"all results/generated/bedroom/table3.csv"}
@@ -22,3 +24,5 @@ for round in $(seq "$rounds"); do
     echo "$rev round $round: wall $(echo "$end - $start" | bc) s, $jobs jobs, job time $job_s s"
   done
 done
+echo "evaluation, $a (with its 95% intervals) -> $b, round $rounds:"
+"$root/.venv/bin/python" "$root/bench/compare_metrics.py" "$tmp/sbs_${a}_$rounds" "$tmp/sbs_${b}_$rounds" || true

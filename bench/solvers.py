@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 
 SETS = ("planit", "grains", "grains_decoded", "infinigen", "saog", "real_heldout")
-COLUMNS = ("scenes", "category_kl", "cooccurrence_similarity", "object_collision_rate", "out_of_bounds_rate", "walkable_share", "functional_all",
-           "sca", "seconds_per_scene")
+COLUMNS = ("scenes", "category_kl", "cooccurrence_similarity", "object_collision_rate", "out_of_bounds_rate", "walkable_share",
+           "functional_all", "sca", "seconds_per_scene")
 
 
 def job_seconds(run: Path, rule: str, name: str) -> str:

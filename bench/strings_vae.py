@@ -20,8 +20,7 @@ import torch
 
 from pipeline import config as planit_config
 from pipeline.graphs.files import room_graphs
-from pipeline.methods.strings import rooms as R
-from pipeline.methods.strings import sample as decoding
+from pipeline.methods.strings import rooms as R, sample as decoding
 from pipeline.methods.strings.fit import rooms_of
 from pipeline.methods.strings.train import room_strings
 

@@ -20,11 +20,12 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 import pandas as pd  # noqa: E402
 
+from pipeline.viewer.page import page  # noqa: E402
+from pipeline.viewer.sources import corpus_room  # noqa: E402
+
 from conftest import shared_data  # noqa: E402
 from test_sources import ingest_outputs, run_ingest  # noqa: E402
 from webdriver import Browser  # noqa: E402
-from pipeline.viewer.page import page  # noqa: E402
-from pipeline.viewer.sources import corpus_room  # noqa: E402
 
 
 def spread(data: dict, count: int) -> dict:

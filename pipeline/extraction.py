@@ -16,7 +16,7 @@ import shapely
 
 from .geometry import meshes, relations
 from .geometry.boxes import SIDE_NORMALS, SIDES, diagonal_2d, rotation
-from .geometry.polygon import segment_distances
+from .geometry.polygon import nearest_segment
 from .geometry.raycast import RoomScene
 from .room import BOX_COLUMNS, RoomInput, Walls, merge_walls, wall_footprints
 
@@ -116,7 +116,8 @@ def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: fl
     ``b`` (n, 7) boxes, ``sc`` the ``extract.support`` config, ``floor_contact`` (m) how high a bottom may be and
     still stand on the floor, ``boxy (n,)`` which objects' models are only boxes. Objects raised above
     ``floor_contact`` cast a grid of rays down; each ray takes the nearest upward-facing surface of another
-    object within reach (a downward-facing one only when the ray did not start inside that object); the parent is the object under the largest area. The box-contact rules join box-only
+    object within reach (a downward-facing one only when the ray did not start inside that object); the parent is
+    the object under the largest area. The box-contact rules join box-only
     objects alone. Returns ``parent (n,)``, ``area (n,)`` m^2, the number of rays and of support cycles broken.
     """
     n = len(b)
@@ -423,12 +424,11 @@ def _architecture_edges(g: RoomGraph, room_id: str, walls: Walls, openings: list
             overlap = min(t[1], walls.length[i]) - max(t[0], 0.0)
             if dist > 0 and overlap >= cfg["facing_min_overlap"] * min(walls.length[i], walls.length[j]):
                 g.edges.append(_edge(room_id, walls.ids[i], walls.ids[j], "wall_opposite", "front", "distant", gap=dist))
-    segments = np.stack([walls.a, walls.b], axis=1)
     for o in openings:
         mid = np.array([(o["x0"] + o["x1"]) / 2, (o["y0"] + o["y1"]) / 2])
-        dist = segment_distances(mid, segments)
-        wi = int(np.argmin(dist))
-        if dist[wi] > cfg["opening_tolerance"]:
+        dist, wi = nearest_segment(mid, walls.segments)
+        wi = int(wi)
+        if dist > cfg["opening_tolerance"]:
             g.skipped.append((o["element_id"], "opening lies on no wall of the room"))
             continue
         width = float(math.hypot(o["x1"] - o["x0"], o["y1"] - o["y0"]))

@@ -132,7 +132,8 @@ SCHEMAS: dict[str, pa.Schema] = {
         _f("source", _CAT),
         _f("item", _STR, doc="house / room / object / model the row is about"),
         _f("kind", _CAT, doc="house | room | wall | object | model | category"),
-        _f("status", _CAT, doc="read | skipped | kept | dropped | fallback | found | backed | open | renamed | uid (item: a house uid read, reason: its file) | duplicate uid"),
+        _f("status", _CAT, doc="read | skipped | kept | dropped | fallback | found | backed | open | renamed | uid (item: a house uid "
+                               "read, reason: its file) | duplicate uid"),
         _f("reason", _STR),
         _f("count", pa.int64()),
     ]),
@@ -192,7 +193,8 @@ SCHEMAS: dict[str, pa.Schema] = {
 }
 
 # refinement adds columns to the raw graph tables
-SCHEMAS["final_nodes"] = pa.schema([*SCHEMAS["nodes"], _f("role", _CAT, doc="hub | spoke | chain_start | chain_member | chain_end | none (chain roles may combine with hub roles: 'hub+chain_start')"),
+SCHEMAS["final_nodes"] = pa.schema([*SCHEMAS["nodes"], _f("role", _CAT, doc="hub | spoke | chain_start | chain_member | chain_end | none "
+                                                                    "(chain roles may combine with hub roles: 'hub+chain_start')"),
                                     _f("group_id", _STR, doc="the hub or chain the node belongs to")])
 SCHEMAS["final_edges"] = pa.schema([*SCHEMAS["edges"],
                                     _f("status", _CAT, doc="kept | pruned"),
@@ -219,7 +221,8 @@ SCHEMAS["scenes"] = pa.schema([
     _f("attempts", _I32, doc="searches from scratch: 1 + the restarts used (instantiate.restarts); the counts add up over them"),
     _f("failures", _STR, doc="JSON: rejections per check (outside, overhangs, collides, violates)"),
     _f("drops", _STR, doc="JSON: per object a partial scene left out, its id, category, cause ('no_place': budget "
-       "spent, 'no_model': no training instance, 'support_dropped') and, for no_place, the check that refused it most ('no_cell': no free cell left)"),
+       "spent, 'no_model': no training instance, 'support_dropped') and, for no_place, the check that refused it most "
+       "('no_cell': no free cell left)"),
     _f("planned_edges", _I32, doc="planned support and spatial edges between placed nodes"),
     _f("found_edges", _I32, doc="of those, found again exactly by extraction"),
     _f("consistency", _F64, doc="found_edges / planned_edges"),

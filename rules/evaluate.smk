@@ -105,7 +105,7 @@ rule runtime:
         table=RUNTIME,
         table_html=report(RUNTIME_HTML, caption="../report/runtime.rst", category="7. Run time"),
     params:
-        config=keys(),
+        config=keys("runtime"),
         io=stage_io("runtime"),
     log:
         "logs/runtime/runtime.log",

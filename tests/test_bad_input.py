@@ -15,11 +15,12 @@ import pyarrow.parquet as pq
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
-from pipeline.stage import Files
 from pipeline import config, tables
-from pipeline.stages import ingest, ingest_summary
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.errors import InputError
+from pipeline.stage import Files
+from pipeline.stages import ingest, ingest_summary
+
 from conftest import shared_data
 
 FIX = Path(__file__).parent / "fixtures" / "front3d"

@@ -5,8 +5,8 @@ import sys
 from pathlib import Path
 
 import pyarrow as pa
-import pytest
 import pyarrow.parquet as pq
+import pytest
 
 from pipeline import tables
 
@@ -36,8 +36,8 @@ def test_stats_on_bad_input_names_the_file(tmp_path):
 
 def test_stage_with_missing_input_fails_cleanly(tmp_path):
     f = tmp_path / "f"
-    out = planit("filter_rooms", "--rooms", str(tmp_path / "nowhere/rooms-0.parquet"), "--architecture", "a", "--objects", "o", "--models", "m",
-                 "--counts", "c", "--out-rooms", str(f / "rooms.parquet"), "--out-report", str(f / "report.parquet"))
+    out = planit("filter_rooms", "--rooms", str(tmp_path / "nowhere/rooms-0.parquet"), "--architecture", "a", "--objects", "o",
+                 "--models", "m", "--counts", "c", "--out-rooms", str(f / "rooms.parquet"), "--out-report", str(f / "report.parquet"))
     assert out.returncode == 2 and "nowhere/rooms-0.parquet" in out.stderr and "Traceback" not in out.stderr
     assert len(out.stderr.strip().splitlines()) <= 2  # the log line and the error line
     assert not f.exists() or not any(f.iterdir())

@@ -6,11 +6,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.stage import Files
 from pipeline import config
 from pipeline.filtering import category_room_counts, filter_rooms
 from pipeline.geometry import collision, meshes
 from pipeline.geometry.raycast import intersector_class
+from pipeline.stage import Files
+
 from conftest import Room, l_sofa_mesh, shared_data, table_mesh
 
 EMBREE = intersector_class("embree")
@@ -85,8 +86,9 @@ def test_real_furniture_meshes_overlap_far_less_than_their_boxes(tmp_path):
     """The 3D-FRONT sample with real 3D-FUTURE meshes: every pair whose boxes overlap by more than the filter's
     0.15 m is measured on the meshes; chairs tucked under tables overlap 0.4 m as boxes and about 3 cm as meshes."""
     from pipeline import tables
-    from pipeline.geometry.collision import world_mesh as _world
     from pipeline.geometry import boxes
+    from pipeline.geometry.collision import world_mesh as _world
+
     from test_sources import run_ingest
 
     sample = shared_data("3d-front-meshes")
@@ -115,8 +117,8 @@ def test_real_furniture_meshes_overlap_far_less_than_their_boxes(tmp_path):
     cfg = config.validate({"source": "front3d", "shards": 1})
     ing = tmp_path / "ingest"
     symmetry.run(cfg, Files(models=[ing / "models-0.parquet"]), Files(table=tmp_path / "sym.parquet", agreement=tmp_path / "sym.json"))
-    extract_graphs.run(cfg, Files(rooms=ing / "rooms-0.parquet", architecture=ing / "architecture-0.parquet", objects=ing / "objects-0.parquet",
-                                  models=ing / "models-0.parquet", symmetry=tmp_path / "sym.parquet"),
+    extract_graphs.run(cfg, Files(rooms=ing / "rooms-0.parquet", architecture=ing / "architecture-0.parquet",
+                                  objects=ing / "objects-0.parquet", models=ing / "models-0.parquet", symmetry=tmp_path / "sym.parquet"),
                        Files(nodes=tmp_path / "n.parquet", edges=tmp_path / "e.parquet", summary=tmp_path / "s.json"), shard=0)
     nodes = pd.read_parquet(tmp_path / "n.parquet")
     edges = pd.read_parquet(tmp_path / "e.parquet")

@@ -6,6 +6,7 @@ import pytest
 import yaml
 
 from pipeline import config
+
 from conftest import ROOT
 
 
@@ -72,7 +73,7 @@ def _conda_pins(path) -> dict:
 
 def test_gpu_environment_has_the_same_pins_as_the_cpu_one():
     cpu, gpu = _conda_pins(ROOT / "environment.yml"), _conda_pins(ROOT / "environment-gpu.yml")
-    test_only = {"pytest", "pytest-xdist", "hypothesis", "import-linter", "snakemake-executor-plugin-slurm"}
+    test_only = {"pytest", "pytest-xdist", "hypothesis", "import-linter", "ruff", "mypy", "snakemake-executor-plugin-slurm"}
     assert {k: v for k, v in cpu.items() if k not in test_only} == gpu
     assert "pytorch-cuda" in (ROOT / "environment-gpu.yml").read_text()
 

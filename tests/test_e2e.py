@@ -13,9 +13,10 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from pipeline.stage import Files
 from pipeline import tables
 from pipeline.learning import checkpoint
+from pipeline.stage import Files
+
 from conftest import ROOT
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("e2e_run")]
@@ -231,7 +232,8 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
         folder = res / "generated" / room_type / "planit"
         scenes = pd.read_parquet(folder / "scenes.parquet")
         sampled = pd.read_parquet(res / "graph_model" / room_type / "planit" / "sampled" / "nodes.parquet").scene_id.nunique()
-        assert len(scenes) == min(2, sampled)  # failed scenes are recorded, never dropped
+        # failed scenes are recorded, never dropped; a failed sampled graph is replaced by the next (graph_draws)
+        assert (scenes.status == "placed").sum() == min(2, sampled) or len(scenes) == min(2 * 3, sampled)
         assert set(scenes.status) <= {"placed", "failed"} and (scenes[scenes.status == "failed"].reason != "").all()
         entries = tables.read_archive(folder / "scenes.zip")  # one file, no folder: a GLB, PNG and JSON per scene
         assert sorted(entries) == sorted(f"{s}.{ext}" for s in scenes.scene_id for ext in ("glb", "json", "png"))
@@ -247,7 +249,7 @@ def test_sampled_graphs_are_placed_into_rooms_every_stage_reads(run_dir, tmp_pat
         assert tables.metadata(res / "generated" / "bedroom" / rel)["pipeline.schema"] == f"{name}/v1", rel
     table = pd.read_csv(res / "generated" / "bedroom" / "table3.csv")
     assert table.variant.tolist() == ["heldout", "random_location", "unconditional", "no_pruning", "half_pruning",
-                                      "no_ordering"]
+                                      "no_ordering", "paper_cfcn", "paper_fcn"]  # Table 3 also in the paper's setting
     assert (res / "placement" / "bedroom" / "fcn" / "model.pt").exists()
     # the generated bedrooms run through the extraction stage unchanged
     gen = res / "generated" / "bedroom" / "planit"
@@ -264,7 +266,7 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
     from pipeline.corpus.procedural_rules import RULES
 
     res = run_dir / "results"
-    sets = {"planit", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "grains", "grains_decoded",
+    sets = {"planit", "planit_prior", "random_sampled", "unconditional_sampled", "strings", "strings_tagged", "grains", "grains_decoded",
             "infinigen", "saog", "retrieval", "real_heldout"}
     for room_type in LEARNED:
         m = json.loads((res / "eval" / room_type / "metrics.json").read_text())
@@ -397,8 +399,10 @@ def test_the_run_time_table_holds_every_benchmarked_job(run_dir):
     built = (run_dir / "results" / "runtime.csv").stat().st_mtime  # Table 3's jobs ran later, in a second run
     jobs = [p for p in (run_dir / "benchmarks").glob("*/*.tsv") if p.stat().st_mtime <= built]
     rules = {p.parent.name for p in jobs}
-    assert rules == set(table.index[2:]) and {"ingest", "train_placement", "generate", "evaluate"} <= rules
-    assert table.loc[TOTAL, "jobs"] == len(jobs) and table.loc[TOTAL, "jobs"] == table.jobs.iloc[2:].sum()
+    per_rule = table.iloc[2:][~table.index[2:].str.contains("/")]
+    assert rules == set(per_rule.index) and {"ingest", "train_placement", "generate", "evaluate"} <= rules
+    assert table.loc[TOTAL, "jobs"] == len(jobs) and table.loc[TOTAL, "jobs"] == per_rule.jobs.sum()
+    assert table.loc["generate/planit", "budget_seconds"] > 0  # each method's generation beside its budget
     wall, total = table.loc[WALL, "job_seconds"], table.loc[TOTAL, "job_seconds"]
     assert 0 < wall and total / 2 - 1 <= wall  # two cores: the span is at least half the job time
 
@@ -421,7 +425,8 @@ def test_the_report_gathers_counts_tables_curves_evaluation_and_gallery(run_dir)
                  "results/eval/bedroom/power.png", "results/runtime.html"):
         assert f'"{item}": {{' in html, item
     for item in ("results/filter/rule_counts.tsv", "results/graphs/ingested/report/table1.csv",
-                 "results/generated/bedroom/table3.csv", "results/eval/bedroom/metrics.csv", "results/runtime.csv"):  # the tables' CSV files are for programs
+                 "results/generated/bedroom/table3.csv", "results/eval/bedroom/metrics.csv",
+                 "results/runtime.csv"):  # the tables' CSV files are for programs
         assert f'"{item}": {{' not in html, item
     gallery = run_dir / "results" / "eval" / "bedroom" / "gallery.png"  # embedded whole, as a PNG
     entry = html[html.index('"results/eval/bedroom/gallery.png": {'):]

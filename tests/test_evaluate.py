@@ -7,10 +7,11 @@ import os
 import numpy as np
 import pytest
 
-from conftest import Room, default_config, l_sofa_mesh
-from pipeline.stage import Files
 from pipeline.evaluation import distributions, physical, render, walkability
 from pipeline.geometry.raycast import intersector_class
+from pipeline.stage import Files
+
+from conftest import Room, default_config, l_sofa_mesh
 
 SQUARE = [(0, 0), (4, 0), (4, 4), (0, 4)]
 
@@ -145,9 +146,10 @@ def test_the_classifier_render_shows_the_floor_and_which_way_an_object_faces():
 def test_metrics_on_real_3d_front_rooms_are_finite_and_agree_with_the_filter(tmp_path):
     """Real 3D-FUTURE meshes: every metric runs on the mesh sample's rooms. Collisions on meshes are never more
     than on boxes (an L-sofa's box covers its coffee table); every share is in [0, 1]."""
-    from conftest import shared_data
     from pipeline import tables
     from pipeline.room import room_inputs
+
+    from conftest import shared_data
     from test_sources import ingest_outputs, run_ingest
 
     sample = shared_data("3d-front-meshes")
@@ -197,6 +199,25 @@ def test_the_classifier_separates_separable_renders_and_not_identical_ones(separ
     else:
         assert 50.0 <= out["accuracy"] <= 62.0 and out["low"] <= 55.0  # folded: 50 is chance
 
+def test_one_shared_classifier_scores_each_set_on_its_own_head():
+    """The shared mode (one classifier per fold, a head per set): a separable set, a set like the real renders and a
+    set made from the held-out renders themselves, trained together; each keeps its own score, halves and test
+    renders, the separable one detected, the other two at chance."""
+    from pipeline.evaluation.sca import sca_shared
+
+    rng = np.random.default_rng(0)
+    cfg = {**default_config()["evaluate"]["sca"], "steps": 200, "width": 8, "device": "cpu", "shared_batch_size": 48}
+    real_train, real_test = _squares(60, 0, rng), _squares(40, 0, rng)
+    copies = np.repeat(real_test, 2, axis=0)  # two copies of each held-out render, grouped by it
+    sets = {"red": (_squares(60, 2, rng), np.arange(60), None), "like": (_squares(60, 0, rng), np.arange(60), None),
+            "copies": (copies, np.repeat(np.arange(40), 2), np.arange(40)), "one_room": (real_test[:1], np.zeros(1), None)}
+    out = sca_shared(real_train, real_test, sets, cfg, seed=0)
+    assert out["red"]["accuracy"] >= 95.0 and out["red"]["test"] == 40 * 2 + 60
+    assert 50.0 <= out["like"]["accuracy"] <= 62.0 and out["like"]["low"] <= 55.0
+    assert out["copies"]["test"] == 40 + 80  # each fold tests only the real renders of its own test half
+    assert 50.0 <= out["copies"]["accuracy"] <= 65.0
+    assert np.isnan(out["one_room"]["accuracy"])  # one group: no two halves
+
 
 def test_generator_rules_read_an_extracted_room():
     """A bed against a wall between two nightstands, a lamp on one: the procedural rules hold on its extracted graph;
@@ -221,18 +242,30 @@ def test_run_time_gathers_benchmarks_per_rule_and_the_wall_clock_span(tmp_path):
 
     header = "s\th:m:s\tmax_rss\tmax_vms\n"
     for rule, job, seconds, rss, end in [("train", "bedroom", 10.0, "300.5", 1000), ("ingest", "0", 5.0, "120", 1020),
-                                         ("ingest", "1", 3.0, "NA", 1003)]:
+                                         ("ingest", "1", 3.0, "NA", 1003), ("generate", "bedroom-planit", 0.5, "9", 1004),
+                                         ("generate", "office-planit", 0.5, "9", 1005)]:
         (tmp_path / rule).mkdir(exist_ok=True)
         tsv = tmp_path / rule / f"{job}.tsv"
         tsv.write_text(header + f"{seconds}\t0:00:00\t{rss}\t1\n")
         os.utime(tsv, (end, end))
-    table = runtime.run({}, Files(corpus=[], learned=[]), Files(table=tmp_path / "out" / "runtime.csv", table_html=tmp_path / "out" / "runtime.html"), benchmarks=str(tmp_path))
+    budget = {"wall_seconds": 20, "job_seconds": 100, "rules": {"ingest": 10, "generate": 1}, "per_method": {"generate": 0.3}}
+    table = runtime.run({"runtime": budget}, Files(corpus=[], learned=[]),
+                        Files(table=tmp_path / "out" / "runtime.csv", table_html=tmp_path / "out" / "runtime.html"),
+                        benchmarks=str(tmp_path))
     rows = table.set_index("rule")
     assert rows.loc[runtime.WALL, "job_seconds"] == 30.0  # first start 990 (train), last end 1020
-    assert rows.loc[runtime.TOTAL, "job_seconds"] == 18.0 and rows.loc[runtime.TOTAL, "jobs"] == 3
-    assert rows.loc["ingest"].tolist()[:3] == [2, 8.0, 120.0] and table.rule.tolist()[2:] == ["train", "ingest"]
-    assert rows.loc["train", "share"] == pytest.approx(10 / 18, abs=1e-3)
-    assert (tmp_path / "out" / "runtime.csv").read_text().splitlines()[0] == "rule,jobs,job_seconds,peak_rss_mb,share"
+    assert rows.loc[runtime.TOTAL, "job_seconds"] == 19.0 and rows.loc[runtime.TOTAL, "jobs"] == 5
+    assert rows.loc["ingest"].tolist()[:3] == [2, 8.0, 120.0]
+    assert table.rule.tolist()[2:] == ["train", "ingest", "generate", "generate/planit"]
+    assert rows.loc["train", "share"] == pytest.approx(10 / 19, abs=1e-3)
+    # each row beside its budget: the wall clock passed its 20 s, ingest kept its 10 s, train has none
+    assert rows.loc[runtime.WALL, "over_budget"] and not rows.loc["ingest", "over_budget"]
+    assert np.isnan(rows.loc["train", "budget_seconds"]) and not rows.loc["train", "over_budget"]
+    # per method: both room types' jobs, the slowest (0.5 s) held against 0.3 s per method and room type
+    assert rows.loc["generate/planit", "jobs"] == 2 and rows.loc["generate/planit", "job_seconds"] == 1.0
+    assert rows.loc["generate/planit", "budget_seconds"] == 0.3 and rows.loc["generate/planit", "over_budget"]
+    assert ((tmp_path / "out" / "runtime.csv").read_text().splitlines()[0]
+            == "rule,jobs,job_seconds,peak_rss_mb,share,budget_seconds,over_budget")
     assert 'data-value="30.0"' in (tmp_path / "out" / "runtime.html").read_text()  # the wall-clock span, in the page
 
 

@@ -18,7 +18,6 @@ import pyarrow as pa
 import pytest
 import yaml
 
-from conftest import ROOT, Room, shared_data
 from pipeline import config, tables
 from pipeline.corpus import ithor
 from pipeline.corpus.front3d import yaw_from_quaternion
@@ -30,6 +29,8 @@ from pipeline.export.shapes import y_up
 from pipeline.geometry.meshes import transform
 from pipeline.stage import Files
 from pipeline.stages import export_rooms
+
+from conftest import ROOT, Room, shared_data
 
 CFG = config.load(ROOT / "config" / "config.yaml")
 OPTIONS = {**CFG["export"], "ithor": CFG["ithor"]}

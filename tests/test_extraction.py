@@ -1,12 +1,14 @@
 """Hand-built rooms with known answers, checked edge by edge against real Embree ray casts."""
 import math
 
+import networkx as nx
 import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
 from pipeline.corpus import furniture
 from pipeline.geometry import relations
+
 from conftest import Room, default_config, edge, l_sofa_mesh, table_mesh
 
 DIST = default_config()["extract"]["distance"]
@@ -162,6 +164,18 @@ def test_support_cycles_are_broken_at_the_largest_object():
     assert relations.tiers(fixed).tolist() == [2, 1, 3, 1]
 
 
+def test_parent_cycles_are_networkx_simple_cycles():
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        n = int(rng.integers(1, 12))
+        parent = {k: (int(p) if p >= 0 else None) for k, p in enumerate(rng.integers(-1, n, n))}
+        graph = nx.DiGraph([(k, p) for k, p in parent.items() if p is not None])
+        found = relations.parent_cycles(parent)
+        assert sorted(map(sorted, found)) == sorted(map(sorted, nx.simple_cycles(graph)))
+        for cycle in found:  # listed child to parent
+            assert [parent[k] for k in cycle] == cycle[1:] + cycle[:1]
+
+
 def test_overlapping_meshes_stack_on_the_larger_supporting_surface():
     r = Room([[0, 0], [4, 0], [4, 4], [0, 4]])
     r.add("desk", "desk", (1.2, 0.6, 0.75), (1.5, 1.0))
@@ -266,7 +280,7 @@ def _exact_gap(anchor, target_poly, direction, inset_fraction=0.1, inset_max=0.4
     lines = shapely.linestrings([[centre + t * tangent - 50 * normal, centre + t * tangent + 50 * normal] for t in ts])
     cuts = shapely.intersection(lines, target_poly)
     best = np.inf
-    for t, cut in zip(ts, cuts):
+    for _t, cut in zip(ts, cuts):
         if cut.is_empty:
             continue
         d = (np.asarray(shapely.get_coordinates(cut)) - centre) @ normal
@@ -289,6 +303,7 @@ def anchor_target_pairs(draw):
 def test_reported_gap_is_the_exact_clearance_for_any_yaw_and_overlap(pair):
     import shapely
     from hypothesis import assume
+
     from pipeline.geometry.boxes import footprint_corners, penetration_depths
 
     anchor, target, snap = pair
@@ -414,9 +429,10 @@ def test_sweeping_some_anchors_finds_exactly_their_edges_of_the_whole_sweep():
 
 def test_sweeping_some_anchors_on_real_3d_front_rooms(tmp_path):
     """The same on the 3D-FRONT sample's rooms, real 3D-FUTURE meshes."""
-    from conftest import shared_data
     from pipeline import tables
     from pipeline.room import room_inputs
+
+    from conftest import shared_data
     from test_sources import run_ingest
 
     sample = shared_data("3d-front-meshes")

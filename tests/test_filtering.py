@@ -7,6 +7,7 @@ from pipeline import config
 from pipeline.corpus import procedural
 from pipeline.filtering import category_room_counts, filter_rooms
 from pipeline.shards import shard_of
+
 from conftest import Room
 
 _C = config.validate({"filter": {"min_category_rooms": 1}})

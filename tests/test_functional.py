@@ -7,10 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+import shapely
+
+from pipeline.evaluation import functional, intervals, perturb, power
+from pipeline.geometry.boxes import footprint_corners
+from pipeline.geometry.function import REGIONS, back_to_wall, facing_angles, footprint_gaps, plan_gaps, regions
 
 from conftest import Room, default_config
-from pipeline.evaluation import functional, intervals, perturb, power
-from pipeline.geometry.function import back_to_wall, facing_angles, plan_gaps, regions, REGIONS
 
 SQUARE = [(0, 0), (4, 0), (4, 4), (0, 4)]
 
@@ -33,6 +36,21 @@ def learned():
     cfg = {**default_config()["evaluate"]["functional"], "min_share": 0.85}  # 25 rooms: Wilson bound 0.87 at best
     train = [bedroom(dx, room_id=f"t{k}") for k, dx in enumerate(np.linspace(-0.6, 0.6, 25))]
     return functional.learn_checks(train, cfg), cfg
+
+
+def test_footprint_gaps_match_shapely_distances():
+    """The NumPy footprint gaps are shapely's polygon distances (0 where footprints overlap or touch)."""
+    rng = np.random.default_rng(3)
+    n = 12
+    b = np.c_[rng.uniform(-3, 3, (n, 2)), rng.uniform(0, 1, n), rng.uniform(0.1, 1, (n, 3)),
+              rng.choice([0.0, np.pi / 2, 0.3, -2.0], n)]
+    b[1] = [b[0, 0] + b[0, 3] + 0.4, b[0, 1], 0.5, 0.4, b[0, 4], 0.5, 0.0]  # flush against box 0's right side
+    b[0, 6] = 0.0
+    polys = shapely.polygons(footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6]))
+    want = shapely.distance(polys[:, None], polys[None, :])
+    assert footprint_gaps(b[:4], b) == pytest.approx(want[:4], abs=1e-12)
+    assert plan_gaps(b) == pytest.approx(want, abs=1e-12)
+    assert footprint_gaps(b[0], b[1])[0, 0] == pytest.approx(0.0, abs=1e-12)
 
 
 def test_the_predicates_place_a_nightstand_at_the_head_and_a_chair_facing_its_desk():

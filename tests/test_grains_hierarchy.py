@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+from pipeline.geometry.frames import wrap
 from pipeline.methods.grains import relpos
 from pipeline.methods.grains.hierarchy import (
     Node,
@@ -66,7 +67,7 @@ def random_box(rng: np.random.Generator, aligned: bool) -> np.ndarray:
 
 
 def yaw_error(a: float, b: float) -> float:
-    return abs(relpos.wrap(a - b))
+    return abs(float(wrap(a - b)))
 
 
 def test_code_round_trips_for_any_yaw():

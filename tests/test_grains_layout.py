@@ -10,6 +10,7 @@ from pipeline.methods.grains.hierarchy import build_tree, decoded_room
 from pipeline.methods.grains.layout import furnish, supports
 from pipeline.placement.retrieval import ModelPool
 from pipeline.room import BOX_COLUMNS
+
 from test_grains_hierarchy import bedroom, make_room
 
 

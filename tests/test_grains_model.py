@@ -13,8 +13,7 @@ import torch
 
 from pipeline.learning import checkpoint
 from pipeline.methods.grains import train
-from pipeline.methods.grains.hierarchy import (KINDS, Node, build_tree, describe, layout, leaves, room_rect,
-                                               tree_depth)
+from pipeline.methods.grains.hierarchy import KINDS, Node, build_tree, describe, layout, leaves, room_rect, tree_depth
 from pipeline.methods.grains.model import CODE, GrainsVAE, Sizes
 from pipeline.room import RoomInput
 

@@ -11,13 +11,18 @@ torch = pytest.importorskip("torch")
 from pipeline import config  # noqa: E402
 from pipeline.corpus import procedural_rules  # noqa: E402
 from pipeline.errors import InputError  # noqa: E402
-from pipeline.graphs import checks as graph_checks  # noqa: E402
-from pipeline.graphs import data as graph_data  # noqa: E402
 from pipeline.evaluation import graphs as graph_metrics  # noqa: E402
-from pipeline.methods.planit.graph_model import sampler  # noqa: E402
-from pipeline.methods.planit.graph_model import spec  # noqa: E402
-from pipeline.methods.planit.graph_model import train  # noqa: E402
+from pipeline.graphs import (
+    checks as graph_checks,  # noqa: E402
+    data as graph_data,  # noqa: E402
+)
 from pipeline.graphs.data import OBJECT_EDGES, Graph  # noqa: E402
+from pipeline.methods.planit.graph_model import (
+    sampler,  # noqa: E402
+    spec,  # noqa: E402
+    train,  # noqa: E402
+)
+
 from conftest import ROOT  # noqa: E402
 
 TINY = {**config.validate({})["graph_model"]["presets"]["tiny"]}
@@ -188,13 +193,12 @@ def test_example_specs_are_valid():
 
 def test_metrics_separate_equal_and_different_sets(bedrooms):
     vocab, graphs = bedrooms
-    classes = range(len(vocab.node_classes))
-    same = graph_metrics.distances(graphs, graphs, classes)
+    same = graph_metrics.distances(graphs, graphs)
     assert same["category_kl"] < 1e-9 and same["node_count_tv"] == 0 and abs(same["degree_mmd"]) < 1e-9
     empty = [Graph(g.room_id, g.node_ids[:g.n_arch], g.node_class[:g.n_arch], g.symmetry[:g.n_arch], g.role[:g.n_arch],
                    g.length[:g.n_arch], g.n_arch, g.edges[(g.edges[:, 0] < g.n_arch) & (g.edges[:, 1] < g.n_arch)],
                    g.angle[(g.edges[:, 0] < g.n_arch) & (g.edges[:, 1] < g.n_arch)]) for g in graphs]
-    assert graph_metrics.distances(graphs, empty, classes)["node_count_tv"] == pytest.approx(1.0)
+    assert graph_metrics.distances(graphs, empty)["node_count_tv"] == pytest.approx(1.0)
     nu = graph_metrics.novelty_uniqueness(graphs[:3] + graphs[:1], graphs[:2])
     assert nu["novelty"] == 0.25 and nu["uniqueness"] == 0.75
 
@@ -281,9 +285,9 @@ def test_count_caps_and_required_categories_keep_sampled_contents_plausible(bedr
 
 def test_every_training_graph_reads_back_from_random_strings(bedrooms):
     """Issue 31: parse(serialize(g)) is isomorphic to g for every procedural training graph and random orders."""
-    from test_strings import isomorphic
-
     from pipeline.methods.strings.serialize import arch_prefix, parse, serialize, serialize_room, string_graph
+
+    from test_strings import isomorphic
 
     vocab, graphs = bedrooms
     rng = np.random.default_rng(0)
@@ -300,10 +304,10 @@ def test_a_room_string_is_read_back_into_its_room_and_broken_ones_are_rejected_b
     """Issue 31: the strings sampler's check (rooms.to_grown) gives a training room's own string back as the same
     graph in that room's architecture, and rejects a truncated string, an architecture atom written among the
     objects, a bond no training graph holds and an object standing apart, each by its cause."""
-    from test_strings import isomorphic
-
     from pipeline.methods.strings.rooms import Rules, to_grown
     from pipeline.methods.strings.serialize import StringGraph, serialize_room, string_graph
+
+    from test_strings import isomorphic
 
     vocab, graphs = bedrooms
     rules = Rules(graphs, vocab, "neighbour", {"cap_counts": True, "required_share": 0.95})

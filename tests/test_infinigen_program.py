@@ -10,8 +10,16 @@ import pytest
 
 from pipeline.errors import InputError
 from pipeline.methods.infinigen.derive import derive_program, program_header, training_rooms
-from pipeline.methods.infinigen.program import (DEFAULT_WEIGHTS, STAGES, TERMS, ObjectRule, Program, dump_program,
-                                                load_program, parse_program)
+from pipeline.methods.infinigen.program import (
+    DEFAULT_WEIGHTS,
+    STAGES,
+    TERMS,
+    ObjectRule,
+    Program,
+    dump_program,
+    load_program,
+    parse_program,
+)
 
 EXAMPLE = """\
 # a bedroom, as shipped

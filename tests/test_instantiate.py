@@ -9,8 +9,6 @@ import numpy as np
 import pytest
 import trimesh
 
-from conftest import Room, default_config
-from pipeline.stage import Files
 from pipeline.geometry.boxes import footprint_corners
 from pipeline.geometry.frames import Frame, equivalent_frames, side_in, to_local, to_world
 from pipeline.geometry.polygon import outside_area
@@ -22,6 +20,9 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import instantiate
+from pipeline.stage import Files
+
+from conftest import Room, default_config
 
 SIZES = {"bed": (1.6, 2.0, 0.5), "nightstand": (0.5, 0.4, 0.55), "table_lamp": (0.2, 0.2, 0.4),
          "wardrobe": (1.0, 0.6, 2.0), "desk": (1.2, 0.6, 0.75)}
@@ -357,10 +358,11 @@ def test_real_3d_front_rooms_are_placed_again_from_their_own_graphs(tmp_path):
     the placed ones hold their planned edges again and collide nowhere."""
     import pandas as pd
 
-    from conftest import shared_data
     from pipeline import config as config_mod, tables
     from pipeline.placement.reinstantiate import own_plans, reinstantiate
     from pipeline.stages import extract_graphs, symmetry
+
+    from conftest import shared_data
     from test_sources import ingest_outputs, run_ingest
 
     sample = shared_data("3d-front-meshes")

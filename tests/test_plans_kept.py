@@ -4,23 +4,20 @@ and failed scenes kept out of the canonical tables."""
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 
 import numpy as np
 import pandas as pd
-import pytest
 
-from conftest import default_config
-from test_functional import bedroom
 from pipeline.geometry.boxes import SIDES
-from pipeline.geometry.frames import Frame
 from pipeline.geometry.function import sides
 from pipeline.methods.interface import Scene
 from pipeline.methods.scenes import Rows, drops, plan_loss
 from pipeline.placement import scene_metrics
 from pipeline.placement.plan import PlanEdge
-from pipeline.placement.search import Anchor
 from pipeline.room.contents import implausible, learn_contents
+
+from conftest import default_config
+from test_functional import bedroom
 
 
 def test_contents_learned_from_training_rooms_flag_excess_and_missing_categories():
@@ -88,6 +85,7 @@ def test_an_object_near_two_opposite_walls_is_an_invalid_plan_unless_training_gr
 
 def test_a_floor_node_with_planned_spatial_edges_takes_an_instance_that_stood_on_the_floor():
     import pandas as pd
+
     from pipeline.placement.retrieval import ModelPool
     row = lambda model, z, hz: {"category": "counter_top", "model_id": model, "cx": 0.0, "cy": 0.0, "cz": z, "hx": 0.5,  # noqa: E731
                                 "hy": 0.3, "hz": hz, "yaw": 0.0, "px": 0.0, "py": 0.0, "pz": z - hz, "sx": 1.0,

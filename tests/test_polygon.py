@@ -4,8 +4,19 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
-from pipeline.geometry.polygon import (extents, make_ccw, merge_collinear, outline_from_loop, polygon_segments,
-                                       segment_distances, segment_interval, signed_area, wall_loop)
+from pipeline.geometry.frames import wrap
+from pipeline.geometry.polygon import (
+    extents,
+    make_ccw,
+    merge_collinear,
+    nearest_segment,
+    outline_from_loop,
+    polygon_segments,
+    segment_distances,
+    segment_interval,
+    signed_area,
+    wall_loop,
+)
 
 SQUARE = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], float)
 L_SHAPE = np.array([[0, 0], [4, 0], [4, 2], [2, 2], [2, 4], [0, 4]], float)
@@ -87,3 +98,16 @@ def test_point_to_wall_distance_and_projection():
     # a door's corners project onto the stretch they cover, clipped to the wall
     p0, p1 = segment_interval(np.array([[1.0, 0.1], [1.9, -0.1], [5.0, 0.0]]), segs[0])
     assert p0 == pytest.approx([1.0, 0.0]) and p1 == pytest.approx([4.0, 0.0])
+    # many points at once: each point's distances, and the nearest wall (the first of equals)
+    pts = np.array([[2.0, 0.3], [5.0, 4.0], [4.0, 0.0]])
+    assert segment_distances(pts, segs) == pytest.approx(np.stack([segment_distances(p, segs) for p in pts]))
+    dist, index = nearest_segment(pts, segs)
+    assert dist == pytest.approx([0.3, math.hypot(1, 1), 0.0]) and index.tolist() == [0, 1, 0]
+
+
+def test_wrap_stays_in_minus_pi_to_pi():
+    a = np.array([-np.pi - 1e-17, -np.pi, np.pi, 3 * np.pi, 7.0, -1e-300])
+    out = wrap(a)
+    assert ((out >= -np.pi) & (out < np.pi)).all()
+    assert out[:4] == pytest.approx([-np.pi] * 4) and out[4] == pytest.approx(7.0 - 2 * np.pi)
+    assert isinstance(wrap(1.0), np.floating)

@@ -12,15 +12,16 @@ import math
 import numpy as np
 import pytest
 
-from conftest import Room, default_config
 from pipeline.geometry.frames import turn_error
 from pipeline.geometry.function import REGIONS, back_to_wall, facing_angles, regions
 from pipeline.geometry.raycast import intersector_class
 from pipeline.placement.checks import Checker
-from pipeline.placement.layout import add_object, walls_of, with_objects, wall_frame
+from pipeline.placement.layout import add_object, wall_frame, walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import instantiate
+
+from conftest import Room, default_config
 
 SIZES = {"bed": (1.6, 2.0, 0.5), "nightstand": (0.45, 0.4, 0.55), "desk": (1.2, 0.6, 0.75), "chair": (0.5, 0.5, 0.9),
          "tv_stand": (1.2, 0.4, 0.5), "tv": (1.0, 0.1, 0.6)}
@@ -267,7 +268,7 @@ def test_an_unsatisfiable_plan_ends_with_its_cause_and_no_relaxed_object():
     """A nightstand planned flush against both long sides and the foot of a bed: two of its three relations always
     break, which the per-object tolerance never allows (at most half of them); the search fails with the object and
     the check that refused it, and records no relaxed object."""
-    from pipeline.placement.proposers import FaceAway, RelationPrior, Combined
+    from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
 
     room, walls, pool, checker, cfg = _corner_room(furnished(0))
     plan = plan_of("n", "nightstand", [PlanEdge("bed", "n", "spatial", "left", "adjacent"),
@@ -283,7 +284,7 @@ def test_an_unsatisfiable_plan_ends_with_its_cause_and_no_relaxed_object():
 def test_an_object_kept_with_a_broken_relation_is_recorded_with_the_edge_and_why():
     """Three planned wall relations of a nightstand in a corner, one of them to the far wall: after its own failures
     the object is kept with that one edge broken, and the record names it and what extraction found instead."""
-    from pipeline.placement.proposers import FaceAway, RelationPrior, Combined
+    from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
 
     room, walls, pool, checker, cfg = setup_room(furnished(0))
     plan = plan_of("n", "nightstand", [PlanEdge(walls.ids[k], "n", "spatial", "front", "adjacent") for k in (2, 3, 0)])

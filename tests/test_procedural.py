@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.corpus import furniture, procedural
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 
 
 @pytest.fixture(scope="module")
@@ -115,7 +115,8 @@ def test_hard_placements_are_recovered_per_case(tmp_path):
     raw = {"nodes": tmp_path / "nodes.parquet", "edges": tmp_path / "edges.parquet"}
     planit("ingest", cfg, {}, t, shard=0)
     planit("symmetry", cfg, {"models": [t["models"]]}, {"table": tmp_path / "sym.parquet", "agreement": tmp_path / "sym.json"})
-    planit("extract_graphs", cfg, {k: t[k] for k in ("rooms", "architecture", "objects", "models")} | {"symmetry": tmp_path / "sym.parquet"},
+    planit("extract_graphs", cfg,
+           {k: t[k] for k in ("rooms", "architecture", "objects", "models")} | {"symmetry": tmp_path / "sym.parquet"},
            {**raw, "summary": tmp_path / "summary.json"}, shard=0)
     planit("score_extraction", cfg, {"nodes": [raw["nodes"]], "edges": [raw["edges"]], "ground_truth": [t["ground_truth"]]},
            {"metrics": tmp_path / "scores.json"})

@@ -5,6 +5,7 @@ from hypothesis import given, strategies as st
 
 from pipeline.graphs.refine import ARCHITECTURE_EDGES, Stats, refine_room
 from pipeline.graphs.superstructures import fits_symmetry
+
 from conftest import Room, default_config
 
 CFG = default_config()["refine"]
@@ -69,7 +70,8 @@ def test_pruning_modes_and_audit_trail():
     kept = lambda r: sum(e["status"] == "kept" for e in r.edges)  # noqa: E731
     assert kept(none) > kept(full)
     assert all(e["rule"] for e in full.edges)
-    wall_far = [e for e in full.edges if e["source"].startswith("wall") and e["edge_type"] == "spatial" and e["distance"] != "adjacent" and e["origin"] == "raw"]
+    wall_far = [e for e in full.edges
+                if e["source"].startswith("wall") and e["edge_type"] == "spatial" and e["distance"] != "adjacent" and e["origin"] == "raw"]
     assert any(e["rule"] == "wall_not_adjacent" for e in wall_far)
     for e in wall_far:  # gone, unless the connectivity repair needed it back
         assert (e["status"], e["rule"]) == ("kept", "connectivity") or e["status"] == "pruned", e

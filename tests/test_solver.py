@@ -207,6 +207,40 @@ def test_objects_left_in_a_hard_violation_are_left_out_and_named():
     assert {d["id"] for d in json.loads(scene.record["drops"])} == {"b", "c"} and scene.record["violations"] == 2
 
 
+GRAMMAR = """\
+room_type: bedroom
+categories:
+  bed:
+    count: {values: [1], probs: [1.0]}
+    wall_angle: {weights: [1.0], mu: [0.0], kappa: [many]}
+groups:
+- {hub: bed, spoke: nightstand, mu: 0.1, sigma: 0.2}
+- {hub: desk, spoke: chair, mu: 0.1}
+affordance: {humans: [bed], extent: 2.0, maps: {}}
+weights: {wall_distance: 1, wall_angle: 1, group: 1, affordance: .nan}
+"""
+
+
+@pytest.mark.parametrize("line, text, message", [
+    (None, None, "g.yaml:5: categories.bed.wall_angle.kappa: 'many' is not of type 'number'"),
+    (5, "    wall_angle: {weights: [1.0], mu: [0.0], kappa: [3.0]}", "g.yaml:8: groups[1].sigma: missing"),
+    (4, "    count: {values: [1], probs: [1.0], odds: 2}", "g.yaml:4: categories.bed.count.odds: unknown field"),
+])
+def test_a_bad_grammar_field_is_named_with_its_file_and_line(tmp_path, line, text, message):
+    from pipeline.errors import InputError
+    from pipeline.methods.saog.layout import load_grammar
+
+    lines = GRAMMAR.splitlines()
+    if line is not None:
+        lines[line - 1] = text
+    if "kappa: [3.0]" in (text or ""):
+        lines[-1] = "weights: {wall_distance: 1, wall_angle: 1, group: 1, affordance: 1}"
+    (tmp_path / "g.yaml").write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError) as info:
+        load_grammar(tmp_path / "g.yaml", "bedroom")
+    assert str(info.value).startswith(str(tmp_path / message)), str(info.value)
+
+
 def test_a_grammar_names_its_errors_and_its_parse_trees_respect_support():
     from pipeline.errors import InputError
     from pipeline.methods.saog.layout import load_grammar
@@ -222,7 +256,7 @@ def test_a_grammar_names_its_errors_and_its_parse_trees_respect_support():
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "g.yaml"
         path.write_text("room_type: bedroom\ncategories: {}\ngroups: []\naffordance: {}\nweights: {group: 1}\n")
-        with pytest.raises(InputError, match="g.yaml: weights: no weight for wall_distance"):
+        with pytest.raises(InputError, match="g.yaml:5: weights.wall_distance: missing"):
             load_grammar(path, "bedroom")
         with pytest.raises(InputError, match="room_type: 'bedroom', the task's is 'office'"):
             load_grammar(path, "office")

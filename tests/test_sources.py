@@ -11,16 +11,17 @@ import pandas as pd
 import pytest
 import shapely
 
-from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
-from pipeline.stage import Files
 from pipeline import config
 from pipeline.corpus import front3d
+from pipeline.corpus.ingest import OUTPUTS as INGEST_OUTPUTS
 from pipeline.errors import InputError
-from pipeline.stages import ingest
 from pipeline.graphs import data as graph_data
 from pipeline.methods.strings.serialize import arch_prefix, parse, serialize, serialize_room, string_graph
-from test_strings import isomorphic
+from pipeline.stage import Files
+from pipeline.stages import ingest
+
 from conftest import ROOT, shared_data
+from test_strings import isomorphic
 
 FIX = Path(__file__).parent / "fixtures"
 
@@ -83,7 +84,8 @@ def test_front3d_malformed_wall_mesh_skips_the_house_with_file_and_field(tmp_pat
     t = run_ingest("front3d", {"houses": str(houses), "future": str(FIX / "front3d/future"),
                                "cache_dir": str(tmp_path / "cache")}, tmp_path / "out")
     skipped = t["drops"][t["drops"].level == "house"]
-    assert skipped[["field", "reason"]].values.tolist() == [["mesh[3].xyz", "mesh[3].xyz: bad 'xyz': expected a list of numbers, 3 per vertex"]]
+    assert skipped[["field", "reason"]].values.tolist() == [
+        ["mesh[3].xyz", "mesh[3].xyz: bad 'xyz': expected a list of numbers, 3 per vertex"]]
     assert skipped.file.iloc[0].endswith("badwall.json") and len(t["rooms"]) == 0
 
 

@@ -11,8 +11,7 @@ import pytest
 
 from pipeline.graphs.data import EDGE_CLASSES
 from pipeline.methods.strings.grammar import learn_grammar
-from pipeline.methods.strings.serialize import (Reader, StringError, StringGraph, arch_prefix, parse, serialize,
-                                               serialize_room, tokens)
+from pipeline.methods.strings.serialize import Reader, StringError, StringGraph, arch_prefix, parse, serialize, serialize_room, tokens
 
 E = EDGE_CLASSES.index
 

@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
-from conftest import Room, default_config
 from pipeline.geometry.frames import Frame
 from pipeline.geometry.raycast import intersector_class
 from pipeline.graphs.data import EDGE_CLASSES, Graph, Vocab
@@ -18,6 +17,8 @@ from pipeline.placement.checks import Checker
 from pipeline.placement.layout import walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.retrieval import ModelPool
+
+from conftest import Room, default_config
 
 E = EDGE_CLASSES.index
 VOCAB = Vocab(("bed", "nightstand", "table_lamp"))
@@ -110,7 +111,7 @@ def test_each_tagged_edge_points_at_the_bond_token_that_wrote_it():
         ex = tagger.example(room, clusters, rng)
         toks = tokens(ex.text)
         assert sorted(ex.edges) == sorted(room.labels)  # every posed edge once
-        for (s, t, c), b, code in zip(ex.edges, ex.bond, ex.code):
+        for (_s, _t, c), b, code in zip(ex.edges, ex.bond, ex.code):
             assert toks[b].startswith("{") and EDGE_CLASSES[c] in toks[b] and code // 2 == c
 
 

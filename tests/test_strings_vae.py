@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from pipeline.methods.strings import sample as decoding
-from pipeline.methods.strings import train
+from pipeline.methods.strings import sample as decoding, train
 from pipeline.methods.strings.grammar import learn_grammar
 from pipeline.methods.strings.serialize import StringError, arch_prefix, parse, serialize_room
 from pipeline.methods.strings.vocab import EOS, UNK, learn_vocab
+
 from test_strings import bedroom, isomorphic
 
 PRESET = {"embed": 16, "hidden": 48, "latent": 8, "layers": 1, "batch_size": 16, "lr": 0.01, "max_epochs": 3,

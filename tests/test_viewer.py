@@ -15,10 +15,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from conftest import ROOT, Room, shared_data
 from pipeline.placement.layout import walls_of
 from pipeline.viewer import payload
 from pipeline.viewer.page import THREE, page
+
+from conftest import ROOT, Room, shared_data
 
 pytestmark = pytest.mark.skipif(not (THREE / "package.json").exists(),
                                 reason="three.js is not installed (make setup runs npm ci for the viewer)")
@@ -121,8 +122,9 @@ def test_the_page_draws_the_room_in_chromium_and_lists_an_objects_edges(tmp_path
 
 
 def test_a_real_3d_front_room_with_its_meshes_draws_with_every_object(tmp_path):
-    from test_sources import ingest_outputs, run_ingest
     from pipeline.viewer.sources import corpus_room
+
+    from test_sources import ingest_outputs, run_ingest
 
     sample = shared_data("3d-front-meshes")
     run_ingest("front3d", {"houses": str(sample / "houses"), "future": str(sample / "3d-future"),

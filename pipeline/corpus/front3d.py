@@ -23,7 +23,7 @@ import shapely
 from shapely.ops import unary_union
 
 from ..errors import InputError
-from ..geometry.polygon import make_ccw, merge_collinear, polygon_segments, segment_distances, segment_interval, signed_area
+from ..geometry.polygon import make_ccw, merge_collinear, nearest_segment, polygon_segments, segment_interval, signed_area
 from .future import FutureModels, MeshCache, norm_category
 from .ledger import Ledger
 from .rows import box_model_row, model_row, opening_row, room_row, wall_rows
@@ -283,9 +283,9 @@ def _openings(rid: str, house: House, room_meshes: list, segs: np.ndarray, floor
         xyz = _mesh_xyz(house, mesh)
         if not len(xyz):
             continue
-        dist = segment_distances(xyz[:, :2].mean(axis=0), segs)
-        w = int(np.argmin(dist))
-        if dist[w] > cfg["opening_max_offset"]:
+        dist, w = nearest_segment(xyz[:, :2].mean(axis=0), segs)
+        w = int(w)
+        if dist > cfg["opening_max_offset"]:
             continue  # not on this room's walls
         p0, p1 = segment_interval(xyz[:, :2], segs[w])
         if np.linalg.norm(p1 - p0) < cfg["opening_min_width"]:

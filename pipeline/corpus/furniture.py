@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry import meshes as M
+from ..seeding import rng_for
 
 
 # --------------------------------------------------------------------------------------------- templates
@@ -266,7 +267,7 @@ RARE = ["aquarium", "harp", "rowing_machine", "telescope", "easel", "globe", "gr
 
 def build_model(category: str, variant: int, seed: int) -> tuple[np.ndarray, np.ndarray, tuple[float, float, float]]:
     """Mesh of one model variant of a category (model space, bottom-centre origin) and its (w, d, h)."""
-    rng = np.random.default_rng([seed, variant, sum(map(ord, category))])
+    rng = rng_for(seed, variant, sum(map(ord, category)))
     cat = CATEGORIES.get(category) or Category(category, "block", ((0.5, 0.9), (0.4, 0.8), (0.6, 1.6)), "rotational-2")
     w, d, h = (lo + (hi - lo) * rng.random() for lo, hi in cat.size)
     if cat.square:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.polygon import polygon_segments, segment_distances, segment_interval
+from ..geometry.polygon import nearest_segment, polygon_segments, segment_interval
 from .rows import box_model_row, opening_row, room_row, wall_rows
 
 GROUPS = {"bedrooms": "bedroom", "living_rooms": "living", "kitchens": "kitchen", "bathrooms": "bathroom"}
@@ -46,10 +46,6 @@ def metadata_path(configured: str | None) -> Path:
 def category(object_type: str) -> str:
     """'ArmChair' -> 'arm_chair'."""
     return re.sub(r"(?<!^)(?=[A-Z])", "_", object_type).lower()
-
-
-def _xyz(p: dict) -> np.ndarray:
-    return np.array([p["x"], p["y"], p["z"]], float) @ UNITY.T
 
 
 def _corners(o: dict) -> np.ndarray | None:
@@ -211,7 +207,7 @@ def _face_away_from_wall(yaw, centre, half, corners, outline):
 
 
 def _window(rid: str, k: int, corners: np.ndarray, segs: np.ndarray, floor_z: float) -> dict:
-    w = int(np.argmin(segment_distances(corners[:, :2].mean(axis=0), segs)))
+    w = int(nearest_segment(corners[:, :2].mean(axis=0), segs)[1])
     p0, p1 = segment_interval(corners[:, :2], segs[w])
     return opening_row(rid, "window", k, p0, p1, corners[:, 2].min() - floor_z, corners[:, 2].max() - floor_z, f"wall_{w}")
 

@@ -22,6 +22,7 @@ import shapely
 
 from ..geometry import boxes
 from ..geometry.polygon import inward_normals, polygon_segments, signed_area
+from ..seeding import rng_for
 from . import furniture
 from .rows import model_row, opening_row, room_row, wall_rows
 
@@ -274,7 +275,7 @@ class RoomBuilder:
                 continue
             s = float(self.rng.uniform(lo, hi))
             placements = []
-            for cat, m, gx, gy, yg in pieces:
+            for _cat, m, gx, gy, yg in pieces:
                 p = wall.a + wall.dir * (s + gx) + wall.normal * gy
                 placements.append((m, float(p[0]), float(p[1]), wall.yaw_in + yg))
             if self.fits(placements, slack):
@@ -291,7 +292,7 @@ class RoomBuilder:
             theta = float(self.rng.integers(4)) * math.pi / 2 + float(self.rng.normal(0, 0.03))
             r = boxes.rotation(theta)
             placements = []
-            for cat, m, gx, gy, yg in pieces:
+            for _cat, m, gx, gy, yg in pieces:
                 p = c + r @ np.array([gx, gy])
                 placements.append((m, float(p[0]), float(p[1]), theta + yg))
             if self.fits(placements):
@@ -635,7 +636,7 @@ def generate_room(index: int, room_type: str, seed: int, models: dict[str, list[
                   defect_rate: float, l_shape_rate: float, placement: dict | None = None) -> RoomBuilder:
     """Generate room ``index`` of ``room_type``; deterministic in ``(seed, room_type, index)``. ``placement``:
     shares of flush, overlapping and turned placements (config ``procedural.placement``; none: clean gaps)."""
-    rng = np.random.default_rng([seed, ROOM_TYPES.index(room_type), index, 7919])
+    rng = rng_for(seed, ROOM_TYPES.index(room_type), index, "procedural-room")
     defect = str(rng.choice(DEFECTS)) if rng.random() < defect_rate else None
     content_type = room_type
     if defect == "mislabeled":

@@ -4,15 +4,21 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable, Sequence
+from typing import Any, TypeVar, cast
 
 import numpy as np
 
+from ..seeding import rng_for
 
-def category_kl(real: Sequence[str], generated: Sequence[str], eps: float = 1e-6) -> float:
+L = TypeVar("L", str, int)  # a category label: a name, or a class index
+P = TypeVar("P")
+
+
+def category_kl(real: Sequence[L], generated: Sequence[L], eps: float = 1e-6) -> float:
     """KL(p || q) of the category frequencies over all objects: p from ``real``, q from ``generated`` (one category
     label per object), ``sum p (log(p + eps) - log(q + eps))`` over the categories of both."""
     cats = sorted(set(real) | set(generated))
-    count = lambda labels: np.array([Counter(labels)[c] for c in cats], dtype=float)
+    count: Callable[[Sequence[L]], np.ndarray] = lambda labels: np.array([Counter(labels)[c] for c in cats], dtype=float)
     return category_kl_counts(count(real), count(generated), eps)
 
 
@@ -34,20 +40,20 @@ def count_distance(real: Sequence[int], generated: Sequence[int]) -> float:
     return float(0.5 * np.abs(_frequencies(real, support) - _frequencies(generated, support)).sum())
 
 
-def _frequencies(values: Sequence, support: list) -> np.ndarray:
+def _frequencies(values: Sequence[int], support: list[int]) -> np.ndarray:
     counts = Counter(values)
     total = max(sum(counts.values()), 1)
     return np.array([counts[v] / total for v in support], dtype=float)
 
 
-def sampling_floor(pool: Sequence, sizes: tuple[int, int], distance: Callable[[list, list], float], repeats: int,
-                   seed: int) -> dict:
+def sampling_floor(pool: Sequence[P], sizes: tuple[int, int], distance: Callable[[list[P], list[P]], float], repeats: int,
+                   seed: int) -> dict[str, Any]:
     """The distance between two disjoint random sets of ``pool`` rooms of ``sizes`` (shrunk in proportion when the
     pool is smaller than their sum), mean and sd over ``repeats`` draws. ``distance`` takes the two lists."""
     a, b = _split_sizes(len(pool), sizes)
     if a == 0 or b == 0:
         return {"mean": float("nan"), "sd": float("nan"), "sizes": [a, b], "repeats": 0}
-    rng = np.random.default_rng([seed, 1414])
+    rng = rng_for(seed, "sampling-floor")
     values = []
     for _ in range(repeats):
         perm = rng.permutation(len(pool))
@@ -77,7 +83,7 @@ def cooccurrence(rooms: Sequence[Sequence[str]], categories: list[str]) -> np.nd
     for i, r in enumerate(rooms):
         has[i, [index[c] for c in set(r) if c in index]] = 1.0
     both, single = has.T @ has, has.sum(0)
-    return np.divide(both, single[None, :], out=np.zeros_like(both), where=single[None, :] > 0)
+    return cast(np.ndarray, np.divide(both, single[None, :], out=np.zeros_like(both), where=single[None, :] > 0))
 
 
 def cooccurrence_similarity(train: Sequence[Sequence[str]], rooms: Sequence[Sequence[str]], min_share: float) -> float:

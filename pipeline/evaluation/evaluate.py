@@ -7,6 +7,7 @@ power check."""
 from __future__ import annotations
 
 from collections import Counter
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -15,6 +16,7 @@ from .. import tables
 from ..geometry.function import off_axis
 from ..geometry.raycast import intersector_class
 from ..placement.checks import Checker
+from ..room import RoomInput
 from . import distributions, functional, intervals, power, render
 from .scores import finite, floors, goals, label_maps, rule_satisfaction, scene_rows, set_counts, train_similarity
 from .sets import REAL, RoomSet
@@ -24,8 +26,9 @@ SETTINGS = ("render", "walk", "cooccurrence_min_share", "collision", "out_of_bou
 EXTRA = ["consistency", "violation", "nn_similarity", "contents_excess", "contents_missing", "functional_all"]
 
 
-def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: RoomSet, real: RoomSet, meshes: dict,
-                       box_models: set, symmetry: dict, threads: int = 1) -> tuple[dict, pd.DataFrame]:
+def evaluate_room_type(config: dict[str, Any], room_type: str, gen: list[RoomSet], train: RoomSet, real: RoomSet,
+                       meshes: dict[str, Any], box_models: set[str], symmetry: dict[str, str],
+                       threads: int = 1) -> tuple[dict[str, Any], pd.DataFrame]:
     """``metrics.json``'s content and the ``eval_scenes`` rows of every set (``gen``: the methods' sets, the first
     one the reference of the differences and the goals)."""
     ev = config["evaluate"]
@@ -70,8 +73,9 @@ def evaluate_room_type(config: dict, room_type: str, gen: list[RoomSet], train: 
     return finite(metrics), scenes
 
 
-def room_rows(rs: RoomSet, learned: dict, index: dict, models: tuple, train_maps, train_ids: list[str],
-              config: dict) -> pd.DataFrame:
+def room_rows(rs: RoomSet, learned: dict[str, Any], index: dict[str, int],
+              models: tuple[dict[str, Any], set[str], dict[str, str]], train_maps: np.ndarray, train_ids: list[str],
+              config: dict[str, Any]) -> pd.DataFrame:
     """One row per room: the ``eval_scenes`` columns, each functional check's outcome and the category counts
     (``models``: meshes, box-only models and the model -> symmetry table)."""
     meshes, box_models, symmetry = models
@@ -85,7 +89,7 @@ def room_rows(rs: RoomSet, learned: dict, index: dict, models: tuple, train_maps
     return pd.concat([scored, fn, counts], axis=1)
 
 
-def off_axis_shares(rooms: list, symmetry: dict, angle_deg: float) -> dict:
+def off_axis_shares(rooms: list[RoomInput], symmetry: dict[str, str], angle_deg: float) -> dict[str, Any]:
     """Share of objects turned more than ``angle_deg`` off their nearest wall's axes: over every object of the rooms
     (``all``) and per category (radially symmetric objects left out), with the objects counted (``counts``)."""
     off, cats = [], []
@@ -98,7 +102,7 @@ def off_axis_shares(rooms: list, symmetry: dict, angle_deg: float) -> dict:
             "categories": {c: round(float(v), 4) for c, v in by.mean().items()}, "counts": by.size().astype(int).to_dict()}
 
 
-def off_axis_gap(shares: dict, train: dict, least: int):
+def off_axis_gap(shares: dict[str, Any], train: dict[str, Any], least: int) -> float | None:
     """The largest gap (share points) between a set's and the training rooms' off-axis shares over the categories
     both hold at least ``least`` (non-radial) objects of; None where there is none."""
     gaps = [abs(v - train["categories"][c]) for c, v in shares["categories"].items()
@@ -106,23 +110,23 @@ def off_axis_gap(shares: dict, train: dict, least: int):
     return round(float(max(gaps)), 4) if gaps else None
 
 
-def classifier_scores(config: dict, by_name: dict, train: RoomSet, real: RoomSet, index: dict,
-                      threads: int) -> tuple[dict, dict]:
+def classifier_scores(config: dict[str, Any], by_name: dict[str, RoomSet], train: RoomSet, real: RoomSet, index: dict[str, int],
+                      threads: int) -> tuple[dict[str, Any], dict[str, Any]]:
     """The classifier's accuracy for every generated set, and for every power set and the real-vs-real control
     with the power check's verdict."""
-    from .sca import sca_scores
+    from .sca import sca_all
 
     ev = config["evaluate"]
     colours = render.palette(sorted(index))
     rgb = lambda rooms: render.classifier_images(rooms, index, colours, ev["render"])
     train_images, real_test = rgb(train.rooms), rgb(real.rooms)
     methods = {name: (rgb(rs.rooms), None, None) for name, rs in by_name.items() if name != REAL}
-    scores = sca_scores((train_images, real_test), methods, ev["sca"], threads, config["seed"])
     own = np.arange(len(real.rooms))  # a power set's copies are grouped by the held-out room they come from
     known = {name: (rgb(rooms), groups, own)
              for name, (rooms, groups) in power.power_sets(real.rooms, ev["power"], config["seed"]).items()}
-    checks = sca_scores((train_images, real_test), known, ev["sca"], threads, config["seed"])
     kept, back = power.control_split(len(train.rooms), max(len(rs.rooms) for rs in by_name.values()), config["seed"])
-    checks |= sca_scores((train_images[kept], real_test), {power.CONTROL: (train_images[back], None, None)},
-                         ev["sca"], threads, config["seed"])
+    every = sca_all((train_images, real_test), {**methods, **known},
+                    (train_images[kept], train_images[back], power.CONTROL), ev["sca"], threads, config["seed"])
+    scores = {n: every[n] for n in methods}
+    checks = {n: every[n] for n in (*known, power.CONTROL)}
     return scores, {"scores": checks, **power.verdict(checks, ev["power"])}

@@ -11,6 +11,7 @@ from .. import tables
 from ..placement.export import plan_figure
 from ..placement.layout import walls_of
 from ..placement.plan import plans_from_tables
+from ..room import RoomInput
 from .sets import RoomSet
 
 
@@ -21,7 +22,7 @@ def gallery(path: Path, gen: RoomSet, archive: Path, real: RoomSet, nodes: Path,
     tables.write_image(path, tile([generated, _real_figures(real.rooms[:count], nodes, edges)]))
 
 
-def _real_figures(rooms: list, nodes: Path, edges: Path) -> list[bytes]:
+def _real_figures(rooms: list[RoomInput], nodes: Path, edges: Path) -> list[bytes]:
     """Each held-out room's top-down PNG with its final graph."""
     flt = [("room_id", "in", [r.room_id for r in rooms])]
     plans = {p.scene_id: p for p in plans_from_tables(tables.read(nodes, "final_nodes", filters=flt).to_pandas(),

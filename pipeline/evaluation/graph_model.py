@@ -3,31 +3,31 @@ sampling floor (fit graphs against held-out ones), validity, novelty, uniqueness
 generator's own arrangement rules. Any graph generator's graphs are scored by this one function."""
 from __future__ import annotations
 
-import numpy as np
+from typing import Any
 
 from ..corpus.procedural_rules import satisfaction
 from ..graphs.data import EDGE_CLASSES, Graph, Vocab
+from ..seeding import rng_for
 from . import graphs as gm
 
 # the issue's quality goals: each distance within this factor of its floor
 FLOOR_FACTOR = 1.5
 
 
-def _rule_view(g, vocab):
+def _rule_view(g: Graph, vocab: Vocab) -> tuple[list[str], list[tuple[int, int, str]]]:
     """(categories, edges with kind names) of a graph, for the procedural rules."""
     cats = [vocab.node_classes[c] for c in g.node_class]
     return cats, [(int(s), int(t), EDGE_CLASSES[int(c)]) for s, t, c in g.edges]
 
 
-def graph_model_metrics(config: dict, room_type: str, vocab: Vocab, real: list[Graph], train: list[Graph],
-                        held: list[Graph], gen: list[Graph], heldout_nll: dict | None,
-                        valid_before_rejection: float) -> dict:
+def graph_model_metrics(config: dict[str, Any], room_type: str, vocab: Vocab, real: list[Graph], train: list[Graph],
+                        held: list[Graph], gen: list[Graph], heldout_nll: dict[str, Any] | None,
+                        valid_before_rejection: float) -> dict[str, Any]:
     """The metrics and goals of one room type's generated graphs ``gen`` against its ``held`` real graphs."""
-    rng = np.random.default_rng([config["seed"], 99])
+    rng = rng_for(config["seed"], "graph-floor")
     floor_set = [train[i] for i in rng.permutation(len(train))[:min(len(gen) or len(train), len(train))]]
-    classes = range(len(vocab.node_classes))
-    floor = gm.distances(held, floor_set, classes)
-    got = gm.distances(held, gen, classes) if gen else {k: None for k in floor}  # nothing valid was sampled
+    floor = gm.distances(held, floor_set)
+    got = gm.distances(held, gen) if gen else {k: None for k in floor}  # nothing valid was sampled
     out = {
         "room_type": room_type, "graphs": {"train": len(train), "heldout": len(held), "generated": len(gen),
                                            "floor_sample": len(floor_set)},
@@ -46,11 +46,11 @@ def graph_model_metrics(config: dict, room_type: str, vocab: Vocab, real: list[G
     return out
 
 
-def _rounded(d: dict) -> dict:
+def _rounded(d: dict[str, Any]) -> dict[str, Any]:
     return {k: None if v is None else round(v, 5) for k, v in d.items()}
 
 
-def _goals(m: dict) -> dict:
+def _goals(m: dict[str, Any]) -> dict[str, Any]:
     """The issue's quality goals, met or not (reported, never tuned against)."""
     r = m["ratio_to_floor"]
     goals = {f"{k}_within_{FLOOR_FACTOR}x_floor": (r[k] is not None and r[k] <= FLOOR_FACTOR)

@@ -3,13 +3,20 @@
 functional checks, the classifier's power check and the goals on one page; the power check as a plot."""
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
 import pandas as pd
 
 from ..html import Table, page
 from .functional import check_name
 from .sets import REAL
 
-FIGURES = {"scenes": "rooms scored (placed)", "attempted": "rooms the method attempted", "category_kl": "category KL to the real rooms (ATISS)", "count_distance": "object-count TV distance",
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+FIGURES = {"scenes": "rooms scored (placed)", "attempted": "rooms the method attempted",
+           "category_kl": "category KL to the real rooms (ATISS)", "count_distance": "object-count TV distance",
            "object_collision_rate": "share of objects colliding (mesh penetration)",
            "scene_collision_rate": "share of rooms with a collision", "out_of_bounds_rate": "share of objects out of bounds",
            "walkable_share": "door-connected share of the free floor", "reachable_scenes": "share of rooms whose every "
@@ -21,7 +28,7 @@ FIGURES = {"scenes": "rooms scored (placed)", "attempted": "rooms the method att
            "seconds_per_scene": "median seconds per scored room (one core)"}
 
 
-def _with_interval(value, span) -> str | int | None:
+def _with_interval(value: Any, span: Sequence[float] | None) -> str | int | None:
     if value is None or value != value:
         return None
     if isinstance(value, int):
@@ -30,14 +37,14 @@ def _with_interval(value, span) -> str | int | None:
     return f"{value:.4g}" if low is None or low != low else f"{value:.4g} [{low:.4g}, {high:.4g}]"
 
 
-def _marks(metrics: dict, name: str, figure: str) -> str:
+def _marks(metrics: dict[str, Any], name: str, figure: str) -> str:
     """``P`` where the set differs from the first method, ``R`` where from the real rooms (interval excludes 0)."""
     first = list(metrics["sets"])[0]
     return "".join(letter for ref, letter in ((first, "P"), (REAL, "R"))
                    if metrics["differences"][f"vs_{ref}"].get(name, {}).get(figure, {}).get("excludes_zero"))
 
 
-def figure_table(metrics: dict, figures: list[str]) -> tuple[pd.DataFrame, pd.DataFrame]:
+def figure_table(metrics: dict[str, Any], figures: list[str]) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Sets as rows, ``figures`` as columns (``value [low, high]``), and the marks."""
     names = list(metrics["sets"])
     frame = pd.DataFrame([{f: _with_interval(metrics["sets"][n].get(f), metrics["sets"][n]["intervals"].get(f))
@@ -46,7 +53,7 @@ def figure_table(metrics: dict, figures: list[str]) -> tuple[pd.DataFrame, pd.Da
     return frame, marks
 
 
-def sca_table(metrics: dict) -> pd.DataFrame:
+def sca_table(metrics: dict[str, Any]) -> pd.DataFrame:
     """The classifier's accuracy per method and per power set, with its interval and whether it is read."""
     passed = metrics["power"]["passed"]
     rows = [{"set": n, "kind": "method", "sca": _with_interval(s["sca"]["accuracy"], [s["sca"]["low"], s["sca"]["high"]]),
@@ -58,7 +65,7 @@ def sca_table(metrics: dict) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("set")
 
 
-def check_rows(metrics: dict) -> pd.DataFrame:
+def check_rows(metrics: dict[str, Any]) -> pd.DataFrame:
     """What each functional check asks, as learned from the training rooms."""
     rows = []
     for c in metrics["functional"]["checks"]:
@@ -70,7 +77,7 @@ def check_rows(metrics: dict) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["check", "every", "stands", "training rooms", "training share"]).set_index("check")
 
 
-def evaluation_page(metrics: dict) -> str:
+def evaluation_page(metrics: dict[str, Any]) -> str:
     """The room type's evaluation page (HTML)."""
     first, real = list(metrics["sets"])[0], REAL
     figures, fmarks = figure_table(metrics, list(FIGURES))
@@ -91,7 +98,7 @@ def evaluation_page(metrics: dict) -> str:
         Table("Goals", goals)])
 
 
-def power_figure(metrics: dict):
+def power_figure(metrics: dict[str, Any]) -> Figure:
     """The classifier's accuracy on each known-bad set and the real-vs-real control, with intervals (a figure)."""
     import matplotlib
 

@@ -7,8 +7,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..geometry.frames import wrap
 from ..geometry.raster import fill_polygon, pixel_centres
 from ..room import RoomInput
+from ..seeding import rng_for
 
 KINDS = ("jitter", "turns", "shuffle", "placement")
 
@@ -19,7 +21,7 @@ def _moved(room: RoomInput, xy: np.ndarray, yaw: np.ndarray, categories: list[st
     shift = xy - b[:, :2]
     b[:, :2] += shift
     p[:, :2] += shift
-    b[:, 6] = p[:, 3] = (yaw + np.pi) % (2 * np.pi) - np.pi
+    b[:, 6] = p[:, 3] = wrap(yaw)
     return replace(room, boxes=b, poses=p, categories=list(categories or room.categories))
 
 
@@ -54,7 +56,7 @@ def placement(room: RoomInput, rng: np.random.Generator, cell: float = 0.05) -> 
 
 def perturbed(rooms: list[RoomInput], kind: str, strength: float, copies: int, seed: int) -> list[RoomInput]:
     """``copies`` perturbed versions of each room (room-major: copies of one room are neighbours), seeded."""
-    rng = np.random.default_rng([seed, 2718, KINDS.index(kind), int(round(strength * 1000))])
+    rng = rng_for(seed, "perturb", KINDS.index(kind), int(round(strength * 1000)))
     make = {"jitter": lambda r: jitter(r, strength, rng), "turns": lambda r: turns(r, rng),
             "shuffle": lambda r: shuffle(r, rng), "placement": lambda r: placement(r, rng)}[kind]
     return [replace(make(r), room_id=f"{r.room_id}~{kind}{k}") for r in rooms for k in range(copies)]

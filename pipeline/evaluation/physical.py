@@ -3,16 +3,18 @@ objects out of bounds (ThreedFront toolkit's test: the footprint eroded by a mar
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
-from ..room import RoomInput
-from ..geometry.collision import penetrating_pairs
 from ..geometry import boxes
+from ..geometry.collision import penetrating_pairs
+from ..geometry.meshes import Mesh
 from ..geometry.polygon import outside_area
+from ..room import RoomInput
 
 
-def colliding(room: RoomInput, parents: Sequence[str | None], meshes: Sequence, cfg: dict) -> np.ndarray:
+def colliding(room: RoomInput, parents: Sequence[str | None], meshes: Sequence[Mesh | None], cfg: dict[str, Any]) -> np.ndarray:
     """``(n,)`` bool: objects penetrating another deeper than ``cfg['max_penetration']``, ignoring support pairs.
 
     ``parents``: each object's support parent id (or None); ``meshes``: each object's ``(vertices, faces)`` or None

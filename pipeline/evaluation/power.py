@@ -5,20 +5,23 @@ perturbation is detected with at least ``min_accuracy`` and the control stays wi
 a method's SCA is only read against its goal when it passes (otherwise: inconclusive)."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..room import RoomInput
+from ..seeding import rng_for
 from .perturb import perturbed
 
 CONTROL = "real_vs_real"
 
 
-def perturbation_name(spec: dict) -> str:
+def perturbation_name(spec: dict[str, Any]) -> str:
     """``jitter_0.1``, ``turns``, ...: a power set's name."""
     return f"{spec['kind']}_{spec['strength']:g}" if spec["kind"] == "jitter" else spec["kind"]
 
 
-def power_sets(real: list[RoomInput], cfg: dict, seed: int) -> dict[str, tuple[list[RoomInput], np.ndarray]]:
+def power_sets(real: list[RoomInput], cfg: dict[str, Any], seed: int) -> dict[str, tuple[list[RoomInput], np.ndarray]]:
     """``name -> (rooms, groups)``: ``cfg['copies']`` perturbed copies of every held-out real room per perturbation
     of ``cfg['perturbations']`` (a room's copies share a group, so they land in the same fold)."""
     groups = np.repeat(np.arange(len(real)), cfg["copies"])
@@ -28,12 +31,12 @@ def power_sets(real: list[RoomInput], cfg: dict, seed: int) -> dict[str, tuple[l
 
 def control_split(rooms: int, size: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """Indices of the training rooms kept in the classifier's real class and of ``size`` held back (at most half)."""
-    perm = np.random.default_rng([seed, 4242]).permutation(rooms)
+    perm = rng_for(seed, "power-control").permutation(rooms)
     back = min(size, rooms // 2)
     return np.sort(perm[back:]), np.sort(perm[:back])
 
 
-def verdict(scores: dict[str, dict], cfg: dict) -> dict:
+def verdict(scores: dict[str, dict[str, Any]], cfg: dict[str, Any]) -> dict[str, Any]:
     """Whether the power check passes: each required perturbation's accuracy and the control's distance from 50%."""
     required = {perturbation_name(p) for p in cfg["perturbations"] if p.get("required")}
     misses = [n for n in sorted(required) if not scores[n]["accuracy"] >= cfg["min_accuracy"]]

@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import colorsys
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
-from ..room import RoomInput
 from ..geometry import boxes
 from ..geometry.raster import fill_polygon, fill_quads
+from ..room import RoomInput
 
 EMPTY = -1
 FLOOR = -2
@@ -71,7 +72,7 @@ def fitted_mpp(room: RoomInput, size: int, finest: float) -> float:
     return max(finest, float((room.outline.max(0) - room.outline.min(0)).max()) * 1.05 / size)
 
 
-def classifier_images(rooms: Sequence[RoomInput], index: dict[str, int], colors: np.ndarray, cfg: dict) -> np.ndarray:
+def classifier_images(rooms: Sequence[RoomInput], index: dict[str, int], colors: np.ndarray, cfg: dict[str, Any]) -> np.ndarray:
     """``(n, size, size, 3)`` classifier images of ``rooms``, each room fitted to the window (``cfg``: ``size``,
     ``finest_mpp``, ``front``)."""
     maps = [classifier_map(r, index, cfg["size"], fitted_mpp(r, cfg["size"], cfg["finest_mpp"]), cfg["front"])

@@ -2,18 +2,24 @@
 similarity, distribution distances beside their sampling floors, the goals and the table of sets."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 import pandas as pd
 
 from ..geometry.raycast import intersector_class
 from ..log import progress
+from ..seeding import rng_for
 from . import distributions, physical, render, walkability
 from .sets import RoomSet
 
+if TYPE_CHECKING:
+    from ..extraction import RoomGraph
+    from ..placement.checks import Checker
 
 
-def scene_rows(rs: RoomSet, meshes: dict, box_models: set, train_maps: np.ndarray, train_ids: list[str],
-               index: dict, config: dict) -> list[dict]:
+def scene_rows(rs: RoomSet, meshes: dict[str, Any], box_models: set[str], train_maps: np.ndarray, train_ids: list[str],
+               index: dict[str, int], config: dict[str, Any]) -> list[dict[str, Any]]:
     """One ``eval_scenes`` row per room of a set."""
     ev = config["evaluate"]
     ccfg = {"max_penetration": ev["collision"]["max_penetration"], "penetration": ev["collision"]["penetration"],
@@ -38,7 +44,7 @@ def scene_rows(rs: RoomSet, meshes: dict, box_models: set, train_maps: np.ndarra
     return rows
 
 
-def rule_view(graph) -> tuple[list[str], list[tuple[int, int, str]]]:
+def rule_view(graph: RoomGraph) -> tuple[list[str], list[tuple[int, int, str]]]:
     """(categories, edges with kind names) of an extracted room graph, for the procedural generator's rules."""
     ids = {n["node_id"]: k for k, n in enumerate(graph.nodes)}
     cats = [n["category"] if n["kind"] == "object" else n["kind"] for n in graph.nodes]
@@ -48,14 +54,14 @@ def rule_view(graph) -> tuple[list[str], list[tuple[int, int, str]]]:
                   if e["source"] in ids and e["target"] in ids]
 
 
-def rule_satisfaction(rs: RoomSet, checker) -> dict:
+def rule_satisfaction(rs: RoomSet, checker: Checker) -> dict[str, Any]:
     """The procedural generator's arrangement rules on each room's extracted graph (the project's extraction)."""
     from ..corpus.procedural_rules import satisfaction  # the procedural corpus's rules: an oracle for its rooms only
 
     return satisfaction([rule_view(checker.extract(r)) for r in progress(rs.rooms, desc=f"rules {rs.name}")])
 
 
-def set_counts(rows: pd.DataFrame, rs: RoomSet) -> dict:
+def set_counts(rows: pd.DataFrame, rs: RoomSet) -> dict[str, Any]:
     """How many rooms a set scores, how many its method attempted and how many of them are partial."""
     seconds = None if rs.scenes is None or rs.scenes["seconds"].isna().all() else float(rs.scenes["seconds"].median())
     relaxed = None if rs.scenes is None or rs.scenes["relaxed_objects"].isna().all() else float(
@@ -65,7 +71,7 @@ def set_counts(rows: pd.DataFrame, rs: RoomSet) -> dict:
             "seconds_per_scene": seconds, "relaxed_share": relaxed}
 
 
-def floors(train: RoomSet, real: RoomSet, generated: int, cfg: dict, seed: int) -> dict:
+def floors(train: RoomSet, real: RoomSet, generated: int, cfg: dict[str, Any], seed: int) -> dict[str, Any]:
     """The category KL and count distance between two disjoint sets of real rooms of the held-out and generated
     sizes (what sample size alone costs)."""
     pool = [r for s in (train, real) for r in s.rooms]
@@ -77,11 +83,11 @@ def floors(train: RoomSet, real: RoomSet, generated: int, cfg: dict, seed: int) 
             "count_distance": distributions.sampling_floor(pool, sizes, count, cfg["floor_repeats"], seed)}
 
 
-def train_similarity(train_maps: np.ndarray, sample: int, seed: int) -> dict:
+def train_similarity(train_maps: np.ndarray, sample: int, seed: int) -> dict[str, Any]:
     """A training room's similarity to its nearest other training room, over a seeded sample of them."""
     if len(train_maps) < 2:
         return {"mean": None, "sd": None, "rooms": 0}
-    pick = np.random.default_rng([seed, 31]).permutation(len(train_maps))[:sample]
+    pick = rng_for(seed, "train-similarity").permutation(len(train_maps))[:sample]
     best = []
     for k in pick:
         sim = render.similarity(train_maps[k], train_maps)
@@ -90,7 +96,7 @@ def train_similarity(train_maps: np.ndarray, sample: int, seed: int) -> dict:
     return {"mean": round(float(np.mean(best)), 5), "sd": round(float(np.std(best)), 5), "rooms": len(pick)}
 
 
-def goals(metrics: dict, first: str, real: str) -> dict:
+def goals(metrics: dict[str, Any], first: str, real: str) -> dict[str, Any]:
     """The evaluation issue's goals for the first method's rooms and for the evaluation itself (reported, never tuned
     against). The classifier's goal reads ``inconclusive`` when its power check failed."""
     sets, fl, checks = metrics["sets"], metrics["floors"], metrics["checks"]
@@ -114,7 +120,7 @@ def goals(metrics: dict, first: str, real: str) -> dict:
     return out
 
 
-def finite(value):
+def finite(value: Any) -> Any:
     """JSON-safe: NaN and infinities become None (recursively)."""
     if isinstance(value, dict):
         return {k: finite(v) for k, v in value.items()}
@@ -125,7 +131,7 @@ def finite(value):
     return value
 
 
-def label_maps(rs: RoomSet, index: dict, cfg: dict) -> np.ndarray:
+def label_maps(rs: RoomSet, index: dict[str, int], cfg: dict[str, Any]) -> np.ndarray:
     """``(n, size, size)`` int16 label maps of a set's rooms."""
     size = cfg["size"]
     maps = [render.label_map(r, index, size, cfg["mpp"]) for r in rs.rooms]
@@ -138,7 +144,7 @@ TABLE_COLUMNS = ["scenes", "attempted", "category_kl", "count_distance", "object
                  "off_axis_share", "off_axis_gap", "seconds_per_scene"]
 
 
-def metrics_table(metrics: dict) -> pd.DataFrame:
+def metrics_table(metrics: dict[str, Any]) -> pd.DataFrame:
     """One row per set with every figure and the classifier's accuracy (the sampling floors and the training
     rooms' own similarity as rows of their own), then one row per power set."""
     rows = [{"set": name, **{k: s.get(k) for k in TABLE_COLUMNS + metrics["checks"]},
@@ -152,7 +158,7 @@ def metrics_table(metrics: dict) -> pd.DataFrame:
     return frame.astype({"scenes": "Int64", "attempted": "Int64"})
 
 
-def _optional(record, column: str):
+def _optional(record: pd.Series | None, column: str) -> float | None:
     """A float of a scene's instantiation record, None where there is no record or no value."""
     if record is None or pd.isna(record[column]):
         return None

@@ -21,7 +21,7 @@ class RoomSet:
     """Rooms of one set with each object's support parent and, for generated sets, the instantiation records."""
     name: str
     rooms: list[RoomInput]
-    parents: list[list]
+    parents: list[list[str | None]]
     scenes: pd.DataFrame | None = None  # scene_id, consistency, violation (placed scenes)
     attempted: int = 0
 
@@ -36,12 +36,12 @@ def room_set(name: str, rooms: pd.DataFrame, architecture: pd.DataFrame, objects
 
 def load_generated(name: str, rooms: Path, architecture: Path, objects: Path, scenes: Path) -> RoomSet:
     """A method's placed scenes, partial ones included (failed ones are counted, not scored)."""
-    scenes = tables.read(scenes, "scenes").to_pandas()
-    placed = set(scenes.loc[scenes["status"].astype(str).isin(SCORED), "scene_id"])
-    rooms = tables.read(rooms, "rooms").to_pandas()
-    out = room_set(name, rooms[rooms["room_id"].isin(placed)], tables.read(architecture, "architecture").to_pandas(),
-                   tables.read(objects, "generated_objects").to_pandas(), scenes[scenes["scene_id"].isin(placed)])
-    out.attempted = len(scenes)
+    scene_df = tables.read(scenes, "scenes").to_pandas()
+    placed = set(scene_df.loc[scene_df["status"].astype(str).isin(SCORED), "scene_id"])
+    room_df = tables.read(rooms, "rooms").to_pandas()
+    out = room_set(name, room_df[room_df["room_id"].isin(placed)], tables.read(architecture, "architecture").to_pandas(),
+                   tables.read(objects, "generated_objects").to_pandas(), scene_df[scene_df["scene_id"].isin(placed)])
+    out.attempted = len(scene_df)
     return out
 
 

@@ -3,12 +3,14 @@ eroded by the agent's radius, as a grid; the share of that free space connected 
 object's front can be reached from a door. SciPy's ndimage does the erosion, labelling and distances."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from scipy import ndimage
 
-from ..room import RoomInput
 from ..geometry import boxes
 from ..geometry.raster import fill_polygon, fill_quads, pixel_centres
+from ..room import RoomInput
 
 
 def walk_grid(room: RoomInput, cell: float, clearance: float) -> tuple[np.ndarray, float, np.ndarray]:
@@ -56,7 +58,7 @@ def front_points(room: RoomInput, clearance: float) -> tuple[np.ndarray, np.ndar
     return idx, np.einsum("nij,nj->ni", boxes.rotation(b[idx, 6]), local) + b[idx, :2]
 
 
-def walkability(room: RoomInput, cfg: dict) -> dict:
+def walkability(room: RoomInput, cfg: dict[str, Any]) -> dict[str, Any]:
     """``walkable_share``: door-connected share of the agent's free space; ``reachable``: share of floor objects
     whose front midpoint lies within ``front_reach`` of a door-connected agent centre; ``all_reachable``."""
     free, cell, centre = walk_grid(room, cfg["cell"], cfg["clearance"])

@@ -20,7 +20,7 @@ from jsonschema import Draft202012Validator
 from jsonschema.exceptions import best_match
 
 from ..errors import InputError
-from ..geometry.polygon import segment_distances
+from ..geometry.polygon import nearest_segment
 from ..placement.layout import walls_of
 from ..room import RoomInput, Walls
 from . import thor
@@ -87,7 +87,7 @@ def _hole(o: dict, walls: Walls, ids: list[str], hid: str) -> dict:
     """A door or window in the wall it lies along: its hole from (start, bottom) to (end, top) in that wall's frame,
     clipped to the wall (an iTHOR window may reach above the room's assumed height)."""
     ends = np.array([[o["x0"], o["y0"]], [o["x1"], o["y1"]]], float)
-    w = int(np.argmin(segment_distances(ends.mean(axis=0), np.stack([walls.a, walls.b], axis=1))))
+    w = int(nearest_segment(ends.mean(axis=0), walls.segments)[1])
     t = np.clip(np.sort((ends - walls.a[w]) @ walls.dir[w]), 0.0, walls.length[w])  # clipped to the wall
     z0, z1 = max(float(o["z0"]), 0.0), min(float(o["z1"]), walls.height)
     hole = {"id": hid, "assetId": thor.hole_asset(str(o["kind"]), float(t[1] - t[0]), z1 - z0), "room0": ROOM,

@@ -115,7 +115,8 @@ def nesting(object_ids: list[str], parents: list[str | None]) -> list[tuple[int,
             j = parent[j]
         if j >= 0:
             parent[k] = -1
-    order, placed = [], set()
+    order: list[tuple[int, int]] = []
+    placed: set[int] = set()
     while len(order) < len(parent):
         for k in range(len(parent)):
             if k not in placed and (parent[k] < 0 or parent[k] in placed):

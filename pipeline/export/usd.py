@@ -50,7 +50,7 @@ def room_stage(stage: Usd.Stage, room: RoomInput, rs: RoomSet) -> None:
     stage.SetDefaultPrim(root)
     _attrs(root, roomId=room.room_id, roomType=room.room_type, source=rs.sources.get(room.room_id, ""))
     stage.CreateClassPrim(PROTOTYPES)
-    protos = {}
+    protos: dict[str, str] = {}
     for model in dict.fromkeys(room.model_ids):
         protos[model] = f"{PROTOTYPES}/model_{len(protos)}"
         v, f = rs.meshes[model]

@@ -5,14 +5,17 @@ y front, z up) and yaw (counter-clockwise about +Z).
 """
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 # local-frame outward unit normals of the four vertical sides
 SIDES = ("front", "back", "left", "right")
 SIDE_NORMALS = np.array([[0.0, 1.0], [0.0, -1.0], [-1.0, 0.0], [1.0, 0.0]])
 
 
-def rotation(yaw) -> np.ndarray:
+def rotation(yaw: ArrayLike) -> np.ndarray:
     """``(..., 2, 2)`` rotation matrices local -> world."""
     c, s = np.cos(yaw), np.sin(yaw)
     out = np.empty(np.shape(c) + (2, 2), np.result_type(c))
@@ -20,18 +23,18 @@ def rotation(yaw) -> np.ndarray:
     return out
 
 
-def footprint_corners(cx, cy, hx, hy, yaw) -> np.ndarray:
+def footprint_corners(cx: ArrayLike, cy: ArrayLike, hx: ArrayLike, hy: ArrayLike, yaw: ArrayLike) -> np.ndarray:
     """``(n, 4, 2)`` world corners of the floor footprints, counter-clockwise."""
     cx, cy, hx, hy, yaw = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (cx, cy, hx, hy, yaw))
     local = np.stack([np.stack([-hx, -hy], -1), np.stack([hx, -hy], -1),
                       np.stack([hx, hy], -1), np.stack([-hx, hy], -1)], 1)  # (n, 4, 2)
     world = np.einsum("nij,nkj->nki", rotation(yaw), local)
-    return world + np.stack([cx, cy], -1)[:, None, :]
+    return cast(np.ndarray, world + np.stack([cx, cy], -1)[:, None, :])
 
 
-def diagonal_2d(hx, hy) -> np.ndarray:
+def diagonal_2d(hx: ArrayLike, hy: ArrayLike) -> np.ndarray:
     """Footprint diagonal length."""
-    return 2.0 * np.hypot(hx, hy)
+    return cast(np.ndarray, 2.0 * np.hypot(hx, hy))
 
 
 def _axes(yaw: np.ndarray) -> np.ndarray:
@@ -45,7 +48,7 @@ def footprint_overlap(corners_a: np.ndarray, yaw_a: np.ndarray, corners_b: np.nd
     pa = np.einsum("nkj,naj->nak", corners_a, axes)
     pb = np.einsum("nkj,naj->nak", corners_b, axes)
     overlap = np.minimum(pa.max(-1), pb.max(-1)) - np.maximum(pa.min(-1), pb.min(-1))
-    return overlap.min(axis=1)
+    return cast(np.ndarray, overlap.min(axis=1))
 
 
 def penetration_depths(boxes: np.ndarray) -> np.ndarray:
@@ -71,4 +74,4 @@ def penetration_depths(boxes: np.ndarray) -> np.ndarray:
 
 def to_local(points: np.ndarray, cx: float, cy: float, yaw: float) -> np.ndarray:
     """World ``(..., 2)`` points into a box's local floor frame."""
-    return (np.asarray(points, dtype=float) - [cx, cy]) @ rotation(yaw)
+    return cast(np.ndarray, (np.asarray(points, dtype=float) - [cx, cy]) @ rotation(yaw))

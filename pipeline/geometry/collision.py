@@ -18,11 +18,12 @@ grids (cubes of ``surface_window`` at ``min_pitch``); the depth is the larger of
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import Any, cast
 
 import numpy as np
 from scipy import ndimage
 
-from .meshes import transform
+from .meshes import Mesh, transform
 from .raycast import RoomScene
 
 # skewed so that rays do not graze the axis-aligned faces and edges furniture is made of
@@ -51,15 +52,16 @@ def crossings_odd(scene: RoomScene, points: np.ndarray, direction: np.ndarray) -
     number of times."""
     crossings = np.zeros(len(points), dtype=np.int64)
 
-    def count(ray, owner, layer, face):  # every hit is refused, so the scene steps through them all
+    # every hit is refused, so the scene steps through them all
+    def count(ray: np.ndarray, owner: np.ndarray, layer: np.ndarray, face: np.ndarray) -> np.ndarray:
         crossings[:] += np.bincount(ray, minlength=len(points))
         return np.zeros(len(ray), dtype=bool)
 
     scene.first_accepted(points, np.broadcast_to(direction, points.shape), count, max_steps=1024)
-    return crossings % 2 == 1
+    return cast(np.ndarray, crossings % 2 == 1)
 
 
-def mesh_scene(mesh: tuple[np.ndarray, np.ndarray], intersector) -> RoomScene:
+def mesh_scene(mesh: tuple[np.ndarray, np.ndarray], intersector: type[Any]) -> RoomScene:
     """A ray scene ``mesh (vertices (v, 3), faces (f, 3))`` alone, for :func:`inside_scene`."""
     return RoomScene([mesh], np.array([0]), np.array([0]), intersector)
 
@@ -75,7 +77,7 @@ def inside_scene(scene: RoomScene, points: np.ndarray) -> np.ndarray:
     split = np.flatnonzero(first != second)
     if len(split):
         out[split] = crossings_odd(scene, points[split], DIRECTIONS[2])
-    return out
+    return cast(np.ndarray, out)
 
 
 def thickness(mask: np.ndarray, pitch: float) -> float:
@@ -86,7 +88,8 @@ def thickness(mask: np.ndarray, pitch: float) -> float:
     return (2.0 * float(ndimage.distance_transform_edt(mask).max()) - 1.0) * pitch + pitch / 2
 
 
-def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], intersector, cfg: dict) -> float:
+def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], intersector: type[Any],
+                     cfg: dict[str, Any]) -> float:
     """Penetration depth (m) of two meshes in world coordinates, each ``(vertices (n, 3), faces (m, 3))``; ``cfg``:
     ``resolution``, ``min_pitch`` (m) and ``max_cells`` of the sampling grid; ``surface_spacing`` (m; null: no
     screen), ``max_surface_points``, ``surface_window`` (m) and ``max_windows`` of the surface screen
@@ -134,11 +137,11 @@ def surface_points(mesh: tuple[np.ndarray, np.ndarray], lo: np.ndarray, hi: np.n
     t = tri[pick]
     points = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
     points -= normal[pick] * (inset / (2 * area[pick]))[:, None]
-    return points[np.all((points >= lo) & (points <= hi), axis=1)]
+    return cast(np.ndarray, points[np.all((points >= lo) & (points <= hi), axis=1)])
 
 
-def surface_depth(meshes: tuple, scenes: tuple[RoomScene, RoomScene], lo: np.ndarray, hi: np.ndarray,
-                  cfg: dict) -> float:
+def surface_depth(meshes: tuple[Mesh, Mesh], scenes: tuple[RoomScene, RoomScene], lo: np.ndarray, hi: np.ndarray,
+                  cfg: dict[str, Any]) -> float:
     """Thickness (m) of the region inside both meshes where their surfaces cross: the points of each mesh's surface
     in the overlap ``[lo, hi]`` (:func:`surface_points`, seeded) that lie inside the other mesh bound that region, so
     :func:`window_depth` measures it around them; 0 where no surface point is inside the other mesh. The points lie
@@ -155,7 +158,7 @@ def surface_depth(meshes: tuple, scenes: tuple[RoomScene, RoomScene], lo: np.nda
 
 
 def window_depth(scenes: tuple[RoomScene, RoomScene], seeds: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                 cfg: dict) -> float:
+                 cfg: dict[str, Any]) -> float:
     """:func:`thickness` of the region inside both meshes in cubes of side ``surface_window`` (m) at pitch
     ``min_pitch``, each centred on one of the points ``seeds (n, 3)`` in the overlap ``[lo, hi]``: one per
     window-sized block holding seeds, at most ``max_windows`` spread over the blocks' sorted order. The cubes'
@@ -179,7 +182,7 @@ def window_depth(scenes: tuple[RoomScene, RoomScene], seeds: np.ndarray, lo: np.
     return thickness(np.pad(windows, ((0, 0), (1, 1), (1, 1), (1, 1))).reshape(-1, side + 2, side + 2), pitch)
 
 
-def penetrating_pairs(box_depth: np.ndarray, objs: dict, cfg: dict) -> Iterator[tuple[int, int, float, str]]:
+def penetrating_pairs(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any]) -> Iterator[tuple[int, int, float, str]]:
     """Pairs ``(i, j, depth, measure)``, deepest box overlap first, that penetrate deeper than ``max_penetration``:
     measured on the meshes where both objects have one (``penetration.measure: mesh``), else on the boxes.
 
@@ -199,7 +202,7 @@ def penetrating_pairs(box_depth: np.ndarray, objs: dict, cfg: dict) -> Iterator[
             yield a, b, d, "meshes"
 
 
-def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], box_depth: float, cfg: dict) -> float:
+def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], box_depth: float, cfg: dict[str, Any]) -> float:
     """Two world meshes' penetration on ``cfg['penetration']``'s grid, measured again on ``cfg['confirm']``'s where
     the first finds at most ``max_penetration`` (``confirm.measure: box`` takes the boxes' depth instead)."""
     d = mesh_penetration(a, b, cfg["intersector"], cfg["penetration"])
@@ -209,7 +212,7 @@ def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarra
     return box_depth if confirm["measure"] == "box" else mesh_penetration(a, b, cfg["intersector"], confirm)
 
 
-def deepest_penetration(box_depth: np.ndarray, objs: dict, cfg: dict) -> tuple[int, int, float, str] | None:
+def deepest_penetration(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any]) -> tuple[int, int, float, str] | None:
     """The first of :func:`penetrating_pairs` (None if no pair penetrates)."""
     return next(penetrating_pairs(box_depth, objs, cfg), None)
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .boxes import SIDES
 
@@ -17,12 +18,13 @@ RADIAL_FRAMES = 8  # radial symmetry: this many turns stand for the continuum
 FOLD = {"rotational-2": 2, "front-back": 2, "rotational-4": 4, "radial": 0}
 
 
-def wrap(angle):
-    """Angles (rad) wrapped to [-pi, pi)."""
-    return (np.asarray(angle, float) + np.pi) % (2 * np.pi) - np.pi
+def wrap(angle: ArrayLike) -> np.ndarray:
+    """Angles (rad) wrapped to [-pi, pi); a remainder that rounds up to 2 pi lands on -pi, not pi."""
+    out = (np.asarray(angle, float) + np.pi) % (2 * np.pi) - np.pi
+    return out - 2 * np.pi * (out >= np.pi)
 
 
-def turn_error(angle, symmetry="none"):
+def turn_error(angle: ArrayLike, symmetry: ArrayLike = "none") -> np.ndarray:
     """``(...)`` smallest turn (rad, 0..pi) from ``angle`` to a turn an object of ``symmetry`` cannot be told apart
     from (0 for radial): how far a yaw difference, or a front's angle to a direction, is from none, counting the
     equivalent fronts of symmetric objects (a rotational-2 keyboard turned by half a turn faces the same way).
@@ -61,13 +63,13 @@ def to_world(frame: Frame, points: np.ndarray) -> np.ndarray:
     return np.stack([c * x - s * p[..., 1], s * x + c * p[..., 1]], -1) + frame.origin
 
 
-def yaw_to_local(frame: Frame, yaw) -> np.ndarray:
+def yaw_to_local(frame: Frame, yaw: ArrayLike) -> np.ndarray:
     """World yaw -> frame yaw (a mirror reverses the turning sense), wrapped to [-pi, pi)."""
     y = np.asarray(yaw, float) - frame.yaw
     return wrap(-y if frame.mirror else y)
 
 
-def yaw_to_world(frame: Frame, yaw) -> np.ndarray:
+def yaw_to_world(frame: Frame, yaw: ArrayLike) -> np.ndarray:
     y = np.asarray(yaw, float)
     return wrap((-y if frame.mirror else y) + frame.yaw)
 

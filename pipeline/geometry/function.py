@@ -10,7 +10,10 @@ back half: a nightstand beside a bed's head is ``side_back``), ``corner`` (|u| >
 """
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .boxes import footprint_corners, footprint_overlap, rotation
 from .frames import FOLD, turn_error, wrap
@@ -48,26 +51,35 @@ def sides(boxes: np.ndarray) -> np.ndarray:
     return out.astype(np.int8)
 
 
-def plan_gaps(boxes: np.ndarray) -> np.ndarray:
-    """``(n, n)`` symmetric distance (m) between the footprints of every pair (0 where they overlap)."""
-    b = np.asarray(boxes, float).reshape(-1, 7)
-    n = len(b)
-    corners = footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])  # (n, 4, 2)
-    edges = np.stack([corners, np.roll(corners, -1, axis=1)], 2)  # (n, 4, 2, 2)
-    a, d = edges[:, :, 0], edges[:, :, 1] - edges[:, :, 0]  # (n, 4, 2)
-    p = corners[:, None, :, None, :] - a[None, :, None, :, :]  # (point box, edge box, corner, edge, 2)
+def _corner_edge_gaps(ca: np.ndarray, cb: np.ndarray) -> np.ndarray:
+    """``(k, m)`` least distance from a corner of each footprint ``ca (k, 4, 2)`` to an edge of each
+    ``cb (m, 4, 2)``."""
+    d = np.roll(cb, -1, axis=1) - cb  # (m, 4, 2) edges from each corner to the next
+    p = ca[:, None, :, None, :] - cb[None, :, None, :, :]  # (point box, edge box, corner, edge, 2)
     t = np.clip(np.einsum("pqcej,qej->pqce", p, d) / np.maximum(np.einsum("qej,qej->qe", d, d), 1e-18)[None, :, None],
                 0.0, 1.0)
-    dist = np.linalg.norm(p - t[..., None] * d[None, :, None], axis=-1).min((2, 3))  # corner of p to edges of q
-    gap = np.minimum(dist, dist.T)
-    i, j = np.triu_indices(n, 1)
-    touching = footprint_overlap(corners[i], b[i, 6], corners[j], b[j, 6]) > 0
-    gap[i[touching], j[touching]] = gap[j[touching], i[touching]] = 0.0
+    return cast(np.ndarray, np.linalg.norm(p - t[..., None] * d[None, :, None], axis=-1).min((2, 3)))
+
+
+def footprint_gaps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(k, m)`` distance (m) between the footprint of each of boxes ``a (k, 7)`` and each of ``b (m, 7)`` (0 where
+    they overlap)."""
+    a, b = np.asarray(a, float).reshape(-1, 7), np.asarray(b, float).reshape(-1, 7)
+    ca = footprint_corners(a[:, 0], a[:, 1], a[:, 3], a[:, 4], a[:, 6])
+    cb = footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6])
+    i, j = (x.ravel() for x in np.meshgrid(np.arange(len(a)), np.arange(len(b)), indexing="ij"))
+    touching = (footprint_overlap(ca[i], a[i, 6], cb[j], b[j, 6]) > 0).reshape(len(a), len(b))
+    return np.where(touching, 0.0, np.minimum(_corner_edge_gaps(ca, cb), _corner_edge_gaps(cb, ca).T))
+
+
+def plan_gaps(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n)`` symmetric distance (m) between the footprints of every pair (0 where they overlap)."""
+    gap = footprint_gaps(boxes, boxes)
     np.fill_diagonal(gap, 0.0)
     return gap
 
 
-def facing_angles(boxes: np.ndarray, symmetry=None) -> np.ndarray:
+def facing_angles(boxes: np.ndarray, symmetry: ArrayLike | None = None) -> np.ndarray:
     """``(n, n)`` angle (rad, 0..pi) between target ``j``'s front and the direction from its centre to anchor
     ``i``'s footprint (its nearest point; its centre where ``j``'s centre lies inside it). Row: anchor. With
     ``symmetry (n,)`` (each object's type), a symmetric target's nearest equivalent front counts
@@ -85,7 +97,8 @@ def facing_angles(boxes: np.ndarray, symmetry=None) -> np.ndarray:
     return turn_error(angle, "none" if symmetry is None else np.asarray(symmetry, object)[None, :])
 
 
-def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_angle: float, symmetry=None) -> np.ndarray:
+def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_angle: float,
+                 symmetry: ArrayLike | None = None) -> np.ndarray:
     """``(n,)`` bool: the object's back faces a wall of the floor ``outline (k, 2)`` (its back normal within
     ``max_angle`` rad of the wall's outward normal; with ``symmetry (n,)``, any of a symmetric object's equivalent
     backs) and that back side's midpoint lies within ``max_gap`` m of that wall's inner face, over the wall's
@@ -105,10 +118,10 @@ def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_ang
     d = walls[:, 1] - walls[:, 0]
     along = np.einsum("nwj,wj->nw", rel, d) / np.maximum(np.einsum("wj,wj->w", d, d), 1e-18)
     off = np.einsum("nwj,wj->nw", rel, normal)  # distance in front of the wall's face
-    return np.any((err <= max_angle) & (np.abs(off) <= max_gap) & (along >= 0.0) & (along <= 1.0), axis=1)
+    return cast(np.ndarray, np.any((err <= max_angle) & (np.abs(off) <= max_gap) & (along >= 0.0) & (along <= 1.0), axis=1))
 
 
-def off_axis(boxes: np.ndarray, outline: np.ndarray, angle: float, symmetry=None) -> np.ndarray:
+def off_axis(boxes: np.ndarray, outline: np.ndarray, angle: float, symmetry: ArrayLike | None = None) -> np.ndarray:
     """``(n,)`` float: 1.0 where an object's yaw lies more than ``angle`` rad off the axes of the wall nearest its
     centre (a quarter turn of it), 0.0 where not, NaN for a radially symmetric object (its yaw means nothing)."""
     b = np.asarray(boxes, float).reshape(-1, 7)

@@ -1,44 +1,48 @@
 """Triangle meshes as ``(vertices (n, 3) float, faces (m, 3) int)`` pairs, built with trimesh.creation."""
 from __future__ import annotations
 
+from types import ModuleType
+from typing import Any, cast
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 Mesh = tuple[np.ndarray, np.ndarray]
 
 
-def _creation():
+def _creation() -> ModuleType:
     """trimesh.creation, imported on first use (trimesh takes ~0.7 s to import; most stages never need it)."""
     import trimesh.creation
 
     return trimesh.creation
 
 
-def _pair(m) -> Mesh:
+def _pair(m: Any) -> Mesh:
     return np.asarray(m.vertices, dtype=float), np.asarray(m.faces, dtype=np.int64)
 
 
-def box(extents, centre=(0.0, 0.0, 0.0)) -> Mesh:
+def box(extents: ArrayLike, centre: ArrayLike = (0.0, 0.0, 0.0)) -> Mesh:
     """Axis-aligned box of full ``extents`` (x, y, z) centred at ``centre``."""
     m = _creation().box(extents=np.asarray(extents, dtype=float))
     m.apply_translation(centre)
     return _pair(m)
 
 
-def cylinder(radius: float, height: float, centre=(0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
+def cylinder(radius: float, height: float, centre: ArrayLike = (0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
     """Vertical cylinder."""
     m = _creation().cylinder(radius=radius, height=height, sections=sections)
     m.apply_translation(centre)
     return _pair(m)
 
 
-def cone(radius: float, height: float, base=(0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
+def cone(radius: float, height: float, base: ArrayLike = (0.0, 0.0, 0.0), sections: int = 12) -> Mesh:
     """Vertical cone standing on ``base``."""
     m = _creation().cone(radius=radius, height=height, sections=sections)
     m.apply_translation(base)
     return _pair(m)
 
 
-def sphere(radius: float, centre=(0.0, 0.0, 0.0), subdivisions: int = 1) -> Mesh:
+def sphere(radius: float, centre: ArrayLike = (0.0, 0.0, 0.0), subdivisions: int = 1) -> Mesh:
     m = _creation().icosphere(subdivisions=subdivisions, radius=radius)
     m.apply_translation(centre)
     return _pair(m)
@@ -62,7 +66,7 @@ def to_origin_bottom_centre(mesh: Mesh) -> Mesh:
     return v + shift, f
 
 
-def transform(vertices: np.ndarray, position, yaw: float, scale=(1.0, 1.0, 1.0)) -> np.ndarray:
+def transform(vertices: np.ndarray, position: ArrayLike, yaw: float, scale: ArrayLike = (1.0, 1.0, 1.0)) -> np.ndarray:
     """Model -> world: ``Rz(yaw) (scale * v) + position``."""
     v = np.asarray(vertices, dtype=float) * np.asarray(scale, dtype=float)
     c, s = np.cos(yaw), np.sin(yaw)
@@ -70,7 +74,7 @@ def transform(vertices: np.ndarray, position, yaw: float, scale=(1.0, 1.0, 1.0))
     out[:, 0] = c * v[:, 0] - s * v[:, 1]
     out[:, 1] = s * v[:, 0] + c * v[:, 1]
     out[:, 2] = v[:, 2]
-    return out + np.asarray(position, dtype=float)
+    return cast(np.ndarray, out + np.asarray(position, dtype=float))
 
 
 def prisms(corners: np.ndarray, z0: float, z1: float) -> Mesh:

@@ -5,6 +5,8 @@ Polygons are ``(n, 2) float`` arrays of vertices, not repeated at the end. Wall 
 """
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 
 
@@ -48,11 +50,19 @@ def polygon_segments(xy: np.ndarray) -> np.ndarray:
 
 
 def segment_distances(point: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """Distance from one ``(2,)`` point to each of ``(m, 2, 2)`` segments (to the nearest point on it)."""
+    """``(..., m)`` distance from each ``(..., 2)`` point to each of ``(m, 2, 2)`` segments (to its nearest point)."""
+    p = np.asarray(point, float)[..., None, :]
     a, d = segments[:, 0], segments[:, 1] - segments[:, 0]
     length2 = np.einsum("ij,ij->i", d, d)
-    t = np.clip(np.einsum("ij,ij->i", np.asarray(point, float) - a, d) / np.maximum(length2, 1e-18), 0.0, 1.0)
-    return np.linalg.norm(a + t[:, None] * d - point, axis=1)
+    t = np.clip(np.einsum("...ij,ij->...i", p - a, d) / np.maximum(length2, 1e-18), 0.0, 1.0)
+    return cast(np.ndarray, np.linalg.norm(a + t[..., None] * d - p, axis=-1))
+
+
+def nearest_segment(point: np.ndarray, segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For ``(..., 2)`` points: the distance to the nearest of ``(m, 2, 2)`` segments and its index (``(...)``
+    each; the first of equals)."""
+    dist = segment_distances(point, segments)
+    return dist.min(-1), dist.argmin(-1)
 
 
 def segment_interval(points: np.ndarray, segment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -143,7 +153,7 @@ def outside_area(outline: np.ndarray, corners: np.ndarray, erode: float) -> np.n
     import shapely
 
     eroded = shapely.buffer(shapely.polygons(np.asarray(corners, float)), -erode, join_style="mitre")
-    return shapely.area(shapely.difference(eroded, shapely.Polygon(outline)))
+    return cast(np.ndarray, shapely.area(shapely.difference(eroded, shapely.Polygon(outline))))
 
 
 def door_zones(outline: np.ndarray, doors: np.ndarray, depth: float) -> np.ndarray:

@@ -11,16 +11,20 @@ render costs a few NumPy calls per shape.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any, cast
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 
-def pixel_centres(size: int, mpp: float, centre) -> tuple[np.ndarray, np.ndarray]:
+def pixel_centres(size: int, mpp: float, centre: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Plan coordinates of the pixel centres along x (columns, ``(size,)``) and y (rows, ``(size,)``)."""
     k = (np.arange(size) + 0.5 - size / 2) * mpp
     return centre[0] + k, centre[1] - k
 
 
-def fill_polygon(xy: np.ndarray, size: int, mpp: float, centre) -> np.ndarray:
+def fill_polygon(xy: np.ndarray, size: int, mpp: float, centre: Sequence[float] | np.ndarray) -> np.ndarray:
     """``(size, size)`` bool: pixel centres inside a simple polygon ``xy (k, 2)`` (even-odd scanlines)."""
     xs, ys = pixel_centres(size, mpp, centre)
     a, b = np.asarray(xy, float), np.roll(np.asarray(xy, float), -1, axis=0)
@@ -29,7 +33,7 @@ def fill_polygon(xy: np.ndarray, size: int, mpp: float, centre) -> np.ndarray:
     t = (y - a[None, :, 1]) / np.where(b[:, 1] != a[:, 1], b[:, 1] - a[:, 1], 1.0)[None, :]
     x_at = np.where(crosses, a[None, :, 0] + t * (b[None, :, 0] - a[None, :, 0]), np.inf)
     left_of = (x_at[:, None, :] < xs[None, :, None]).sum(axis=2)  # crossings left of each pixel centre
-    return left_of % 2 == 1
+    return cast(np.ndarray, left_of % 2 == 1)
 
 
 FLAT_WINDOW = 1024  # pixels: smaller windows are tested all at once as one flat array, larger ones one by one
@@ -44,7 +48,8 @@ def _left_of_edges(corners: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.nd
     return inside
 
 
-def quad_pixels(corners: np.ndarray, size: int, mpp: float, centre) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def quad_pixels(corners: np.ndarray, size: int, mpp: float,
+                centre: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pixels whose centres lie inside each convex quad ``corners (n, 4, 2)`` (counter-clockwise), as
     ``(quad, row, col)`` index arrays ``(k,)``. Each quad is tested only within its own bounding window of pixels
     (one pixel wider): windows under :data:`FLAT_WINDOW` pixels all at once, larger ones one by one."""
@@ -65,16 +70,17 @@ def quad_pixels(corners: np.ndarray, size: int, mpp: float, centre) -> tuple[np.
         r, c = np.arange(r0[k], r0[k] + height[k]), np.arange(c0[k], c0[k] + width[k])
         i, j = np.nonzero(_left_of_edges(corners[k], xs[None, c], ys[r, None]))
         out.append((np.full(len(i), k), r[i], c[j]))
-    return tuple(np.concatenate(parts) for parts in zip(*out))
+    q, rows, cols = (np.concatenate(parts) for parts in zip(*out))
+    return q, rows, cols
 
 
-def fill_quads(image: np.ndarray, corners: np.ndarray, value: float, mpp: float, centre) -> None:
+def fill_quads(image: np.ndarray, corners: np.ndarray, value: float, mpp: float, centre: Sequence[float] | np.ndarray) -> None:
     """Set ``value`` in ``image (size, size)`` inside each convex quad ``corners (n, 4, 2)``."""
     _, rows, cols = quad_pixels(corners, image.shape[0], mpp, centre)
     image[rows, cols] = value
 
 
-def segment_quads(segments: np.ndarray, half_width) -> np.ndarray:
+def segment_quads(segments: np.ndarray, half_width: ArrayLike) -> np.ndarray:
     """``(m, 4, 2)`` counter-clockwise slabs around segments ``(m, 2, 2)``, ``half_width`` m either side."""
     a, b = segments[:, 0], segments[:, 1]
     d = b - a
@@ -86,8 +92,8 @@ def segment_quads(segments: np.ndarray, half_width) -> np.ndarray:
 CHANNELS = ("floor", "walls", "doors", "windows", "height", "sin_yaw", "cos_yaw", "anchor")
 
 
-def render_room(outline: np.ndarray, walls: np.ndarray, wall_half: np.ndarray, openings: dict, boxes: np.ndarray,
-                category: np.ndarray, n_categories: int, size: int, mpp: float, centre,
+def render_room(outline: np.ndarray, walls: np.ndarray, wall_half: np.ndarray, openings: dict[str, Any], boxes: np.ndarray,
+                category: np.ndarray, n_categories: int, size: int, mpp: float, centre: Sequence[float] | np.ndarray,
                 anchor: int | None = None) -> np.ndarray:
     """``(len(CHANNELS) + n_categories, size, size)`` float32 top-down view of one room.
 

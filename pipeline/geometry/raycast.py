@@ -6,22 +6,26 @@ from __future__ import annotations
 
 import logging
 import warnings
-
+from collections.abc import Callable
 from types import SimpleNamespace
+from typing import Any, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import PlanitError
 from .meshes import Mesh, combine
 
 log = logging.getLogger("planit.raycast")
+# accept(ray (k,), owner (k,), layer (k,), face (k,)) -> (k,) bool: which hits a ray takes (RoomScene.first_accepted)
+Accept = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
 class BackendError(PlanitError):
     """The requested ray backend is not available."""
 
 
-def intersector_class(backend: str):
+def intersector_class(backend: str) -> type[Any]:
     """The trimesh intersector class for ``backend`` ('embree' or 'python'); fail clearly if Embree is missing."""
     if backend == "embree":
         import importlib.util
@@ -49,7 +53,7 @@ class EmbreeIntersector:
 
     _device = None
 
-    def __init__(self, mesh) -> None:
+    def __init__(self, mesh: Any) -> None:
         from embreex import rtcore, rtcore_scene
         from embreex.mesh_construction import TriangleMesh
 
@@ -64,7 +68,7 @@ class EmbreeIntersector:
     def intersects_first(self, ray_origins: np.ndarray, ray_directions: np.ndarray) -> np.ndarray:
         """Index of the first triangle each ray hits, -1 for none (directions must be unit vectors)."""
         origins = (np.asarray(ray_origins, dtype=np.float64) - self.origin).astype(np.float32)
-        return self.scene.run(origins, np.asarray(ray_directions, dtype=np.float32))
+        return cast(np.ndarray, self.scene.run(origins, np.asarray(ray_directions, dtype=np.float32)))
 
 
 class RoomScene:
@@ -78,13 +82,13 @@ class RoomScene:
     intersector : class from :func:`intersector_class`
     """
 
-    def __init__(self, parts: list[Mesh], owners, layers, intersector) -> None:
+    def __init__(self, parts: list[Mesh], owners: ArrayLike, layers: ArrayLike, intersector: type[Any]) -> None:
         vertices, faces = combine(parts)
         counts = [len(f) for _, f in parts]
         self.owner = np.repeat(np.asarray(owners, dtype=np.int64), counts)
         self.layer = np.repeat(np.asarray(layers, dtype=np.int8), counts)
         if intersector is EmbreeIntersector:  # needs only the arrays: no trimesh import on the fast path
-            mesh = SimpleNamespace(vertices=vertices, faces=faces)
+            mesh: object = SimpleNamespace(vertices=vertices, faces=faces)
         else:
             import trimesh
 
@@ -96,7 +100,7 @@ class RoomScene:
         self.up = self._normal[:, 2] > 0  # faces whose outward normal points up (surfaces that can hold things)
         self._rays = intersector(mesh)
 
-    def first_accepted(self, origins: np.ndarray, directions: np.ndarray, accept, max_dist=np.inf,
+    def first_accepted(self, origins: np.ndarray, directions: np.ndarray, accept: Accept, max_dist: ArrayLike = np.inf,
                        max_steps: int = 256) -> tuple[np.ndarray, np.ndarray]:
         """Nearest hit per ray that ``accept`` takes, stepping through the hits it refuses.
 

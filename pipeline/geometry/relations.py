@@ -5,14 +5,19 @@ visibility sweep's pieces and per-target visibility.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any, TypeVar, cast
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .boxes import footprint_corners, rotation
 
 DISTANCES = ("adjacent", "proximal", "distant")
+T = TypeVar("T")
 
 
-def distance_labels(gap, max_diag, cfg: dict) -> np.ndarray:
+def distance_labels(gap: ArrayLike, max_diag: ArrayLike, cfg: Mapping[str, Any]) -> np.ndarray:
     """adjacent / proximal / distant for gaps (m) between objects whose larger footprint diagonal is ``max_diag``.
 
     adjacent: gap <= min(adjacent_abs, adjacent_rel * max_diag); proximal: gap <= max(proximal_abs,
@@ -65,12 +70,21 @@ def choose_parents(obj: np.ndarray, hit_owner: np.ndarray, hit_dist: np.ndarray,
     return parent, area
 
 
-def _in_box(points: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Whether points ``(..., 3)`` lie inside oriented boxes ``(..., 7)`` (broadcast against each other)."""
+def in_footprint(points: np.ndarray, b: np.ndarray, inset: tuple[float, float] = (0.0, 0.0),
+                 least: float = 0.0) -> np.ndarray:
+    """Whether plan points ``(..., 2)`` (or wider: x, y first) lie inside the footprints of oriented boxes
+    ``(..., 7)`` (broadcast against each other), each shrunk by ``inset`` (x, y) m in its own frame with every half
+    extent kept >= ``least`` m (a negative inset grows it)."""
     rel = points[..., :2] - b[..., :2]
     c, s = np.cos(b[..., 6]), np.sin(b[..., 6])
     lx, ly = rel[..., 0] * c + rel[..., 1] * s, -rel[..., 0] * s + rel[..., 1] * c
-    return (np.abs(lx) <= b[..., 3]) & (np.abs(ly) <= b[..., 4]) & (np.abs(points[..., 2] - b[..., 2]) <= b[..., 5])
+    half = np.maximum(b[..., 3:5] - np.asarray(inset, float), least)
+    return cast(np.ndarray, (np.abs(lx) <= half[..., 0]) & (np.abs(ly) <= half[..., 1]))
+
+
+def _in_box(points: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Whether points ``(..., 3)`` lie inside oriented boxes ``(..., 7)`` (broadcast against each other)."""
+    return cast(np.ndarray, in_footprint(points, b) & (np.abs(points[..., 2] - b[..., 2]) <= b[..., 5]))
 
 
 def box_containment(points: np.ndarray, boxes: np.ndarray, own: np.ndarray,
@@ -96,12 +110,10 @@ def holding_box(boxes: np.ndarray, candidates: np.ndarray, eligible: np.ndarray 
     counter slab, a ladle through a holder). The lowest such box wins; -1 where none."""
     b = np.asarray(boxes, float).reshape(-1, 7)
     bottom = b[:, 2] - b[:, 5]
-    flat = b.copy()
-    flat[:, 5] = np.inf  # the footprint test alone: the vertical condition follows
     out = np.full(len(candidates), -1, dtype=np.int64)
     for i, k in enumerate(candidates):
         k_bottom, k_top = b[k, 2] - b[k, 5], b[k, 2] + b[k, 5]
-        ok = _in_box(b[k, None, :3], flat) & (bottom > k_bottom) & (bottom < k_top)
+        ok = in_footprint(b[k, None, :2], b) & (bottom > k_bottom) & (bottom < k_top)
         ok[k] = False
         if eligible is not None:
             ok &= np.asarray(eligible, bool)
@@ -117,27 +129,35 @@ def hanging(boxes: np.ndarray, parent: np.ndarray, floor_contact: float, min_hei
     bottom = b[:, 2] - b[:, 5]
     is_parent = np.zeros(len(b), bool)
     is_parent[parent[parent >= 0]] = True
-    return (parent < 0) & ~is_parent & (bottom > max(min_height, floor_contact))
+    return cast(np.ndarray, (parent < 0) & ~is_parent & (bottom > max(min_height, floor_contact)))
+
+
+def parent_cycles(parent: Mapping[T, T | None]) -> list[list[T]]:
+    """The cycles of a parent map (node -> its one parent, None for none; a parent missing from the map counts as
+    none), each listed child to parent from where walks from the nodes, in the map's order, first meet it.
+    ``tests/test_extraction.py`` checks them against networkx's ``simple_cycles``."""
+    cycles: list[list[T]] = []
+    done: set[T] = set()
+    for start in parent:
+        path: dict[T, int] = {}
+        node: T | None = start
+        while node is not None and node not in done and node not in path:
+            path[node] = len(path)
+            node = parent.get(node)
+        if node is not None and node in path:  # the walk closed a cycle
+            cycles.append(list(path)[path[node]:])
+        done.update(path)
+    return cycles
 
 
 def break_support_cycles(parent: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
-    """Un-parent the largest object of every support cycle. Returns the new parents and the cycles found."""
-    parent = parent.copy()
-    cycles = []
-    state = np.zeros(len(parent), dtype=np.int8)  # 0 new, 1 on the current path, 2 done
-    for start in range(len(parent)):
-        path, node = [], start
-        while node >= 0 and state[node] == 0:
-            state[node] = 1
-            path.append(node)
-            node = parent[node]
-        if node >= 0 and state[node] == 1:  # closed a cycle
-            cycle = path[path.index(node):]
-            cycles.append(cycle)
-            parent[max(cycle, key=lambda k: size[k])] = -1
-        for p in path:
-            state[p] = 2
-    return parent, cycles
+    """Un-parent the largest object of every support cycle (``parent (n,)``, -1 for none; ``size (n,)``; among
+    equals the first in the cycle's order). Returns the new parents and the cycles found."""
+    cycles = parent_cycles({k: (p if p >= 0 else None) for k, p in enumerate(parent.tolist())})
+    out = parent.copy()
+    for cycle in cycles:
+        out[max(cycle, key=lambda k: size[k])] = -1
+    return out, cycles
 
 
 def tiers(parent: np.ndarray) -> np.ndarray:

@@ -6,6 +6,9 @@ transformed copy must stay under ``tolerance`` times the model's diagonal.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import cast
+
 import numpy as np
 import trimesh
 from scipy.spatial import cKDTree
@@ -36,7 +39,7 @@ def surface_samples(vertices: np.ndarray, faces: np.ndarray, count: int, seed: i
     pts, _ = trimesh.sample.sample_surface(mesh, count, seed=seed)
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
     centre = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, 0.0])
-    return np.asarray(pts) - centre
+    return cast(np.ndarray, np.asarray(pts) - centre)
 
 
 class Invariances:
@@ -64,7 +67,7 @@ def invariances(points: np.ndarray, tolerance: float) -> dict[str, bool]:
     return {name: inv[name] for name in TRANSFORMS}
 
 
-def classify(inv) -> str:
+def classify(inv: Invariances | Mapping[str, bool]) -> str:
     """Symmetry type from invariances (a mapping transform name -> bool), most symmetric first."""
     if inv["rot_odd"] and inv["rot_45"]:
         return "radial"

@@ -32,8 +32,8 @@ def seen_triples(graphs) -> set[tuple[int, int, int]]:
 
 
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
-             seen: set[tuple[int, int, int]], required: set[int] = frozenset(),
-             opposite_ok: set[int] = frozenset()) -> list[str]:
+             seen: set[tuple[int, int, int]], required: set[int] | frozenset[int] = frozenset(),
+             opposite_ok: set[int] | frozenset[int] = frozenset()) -> list[str]:
     """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class); ``required``: node
     classes every graph must hold; ``opposite_ok``: node classes that may stand near two opposite walls."""
     out = [] if len(node_class) > n_arch else ["empty"]  # every real room holds an object

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..geometry.symmetry import TYPES as SYMMETRIES
+from ..seeding import rng_for
 
 ARCH = ("wall", "door", "window")
 ROLES = ("none", "hub", "hub+chain", "spoke", "chain")  # the code's superstructure classes
@@ -158,7 +159,7 @@ def connected_order(graph: Graph, rng: np.random.Generator) -> np.ndarray:
     """A random order of the objects in which each touches (by an edge, either way) a node before it, where the
     graph allows (refined graphs are connected): the next object is drawn among those touching the nodes so far."""
     n = len(graph.node_ids)
-    touch = [set() for _ in range(n)]
+    touch: list[set[int]] = [set() for _ in range(n)]
     for s, t, _ in graph.edges:
         touch[s].add(t)
         touch[t].add(s)
@@ -194,11 +195,12 @@ def sequence(graph: Graph, rng: np.random.Generator, max_edges: int) -> Sequence
     return Sequence(graph, order, links, dropped)
 
 
-def split_heldout(room_ids: list[str], fraction: float, seed: int, stream: int = 4242) -> tuple[list[str], list[str]]:
+def split_heldout(room_ids: list[str], fraction: float, seed: int,
+                  stream: str = "heldout") -> tuple[list[str], list[str]]:
     """A seeded split of room ids into (train, held-out); at least one room in each when there are two or more.
     ``stream`` tells independent splits of one seed apart (the validation split of the training ids uses another)."""
     ids = sorted(room_ids)
-    rng = np.random.default_rng([seed, stream])
+    rng = rng_for(seed, stream)
     perm = rng.permutation(len(ids))
     k = int(round(fraction * len(ids)))
     k = min(max(k, 1 if len(ids) > 1 else 0), max(len(ids) - 1, 0))
@@ -213,5 +215,5 @@ def room_splits(room_ids: list[str], heldout_fraction: float, validation_fractio
     """Seeded split of a room type's rooms: room id -> fit | validation | heldout. The held-out rooms are the test
     rooms of every learner and of the evaluation; the validation rooms come out of the rest."""
     rest, held = split_heldout(room_ids, heldout_fraction, seed)
-    fit, validation = split_heldout(rest, validation_fraction, seed, stream=4343)
+    fit, validation = split_heldout(rest, validation_fraction, seed, stream="validation")
     return {**{r: "fit" for r in fit}, **{r: "validation" for r in validation}, **{r: "heldout" for r in held}}

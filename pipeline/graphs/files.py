@@ -52,11 +52,6 @@ def split_graphs(graphs: list[data.Graph], split: dict[str, str], room_type: str
     return parts
 
 
-def split_ids(split: dict[str, str], *names: str) -> list[str]:
-    """The sorted room ids in any of the named parts of a split."""
-    return sorted(r for r, s in split.items() if s in names)
-
-
 def write_graphs(out, nodes: list[dict], edges: list[dict], summary: dict) -> None:
     """Sampled graphs as generated_nodes / generated_edges tables and their sampling summary (``out``: nodes, edges,
     summary)."""

@@ -18,8 +18,8 @@ import numpy as np
 import pandas as pd
 
 from .. import tables
-from ..log import progress
 from ..geometry.symmetry import TYPES as SYMMETRIES
+from ..log import progress
 from ..room.contents import learn_contents
 from .data import ARCH, EDGE_CLASSES, N_OBJECT_EDGES, ROLES, Graph, Vocab
 

@@ -29,7 +29,8 @@ def _con(nodes: Path, edges: Path, superstructures: Path) -> duckdb.DuckDBPyConn
 
 def graph_tables(folder: Path) -> tuple[Path, Path, Path]:
     """The gathered final graph tables of a corpus folder (``results/graphs/<corpus>``)."""
-    return tuple(Path(folder) / f"{n}.parquet" for n in ("nodes", "edges", "superstructures"))
+    nodes, edges, superstructures = (Path(folder) / f"{n}.parquet" for n in ("nodes", "edges", "superstructures"))
+    return nodes, edges, superstructures
 
 
 def graph_report(nodes: Path, edges: Path, superstructures: Path) -> dict[str, pd.DataFrame]:

@@ -95,7 +95,8 @@ def room_candidates(nodes: dict[str, dict], edges: list[dict], cfg: dict) -> tup
 def select_hubs(candidates: list[Hub], nodes: dict[str, dict], accepted: set[tuple[str, str]]) -> list[Hub]:
     """Keep candidates whose (hub category, spoke category) pattern is frequent dataset-wide; a node is
     hub or spoke of at most one hub (larger hubs with more spokes first)."""
-    chosen, used = [], set()
+    chosen: list[Hub] = []
+    used: set[str] = set()
     order = sorted(candidates, key=lambda h: (-len(h.spokes), -nodes[h.hub]["diag"], h.hub))
     for h in order:
         pattern = (nodes[h.hub]["category"], nodes[h.spokes[0]]["category"])
@@ -132,7 +133,8 @@ def find_chains(nodes: dict[str, dict], edges: list[dict], cfg: dict) -> list[Ch
             if len(path) >= cfg["chain_min_length"]:
                 candidates.append(Chain(path, direction, label))
     candidates.sort(key=lambda c: (-len(c.members), DIRECTION_PREFERENCE.index(c.direction), c.label, c.members))
-    chosen, used = [], set()
+    chosen: list[Chain] = []
+    used: set[str] = set()
     for c in candidates:
         if used & set(c.members):
             continue

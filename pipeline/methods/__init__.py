@@ -7,11 +7,22 @@ import importlib
 from types import SimpleNamespace
 
 from ..errors import InputError
-from .interface import (Corpus, Generated, GraphGenerator, GraphSource, LayoutGenerator, Method, PlacementLearner,
-                        ProgramLearner, Scene, Task)
+from .interface import (
+    Corpus,
+    Generated,
+    GraphGenerator,
+    GraphSource,
+    LayoutGenerator,
+    Method,
+    PlacementLearner,
+    ProgramLearner,
+    Scene,
+    Task,
+)
 
 __all__ = ["Corpus", "Generated", "GraphGenerator", "GraphSource", "LayoutGenerator", "Method", "Scene", "Task", "register",
-           "get", "names", "load_plugins", "layout_of", "graph_generator", "graph_source", "graph_sources_of", "PlacementLearner", "placement_learner", "placement_fit",
+           "get", "names", "load_plugins", "layout_of", "graph_generator", "graph_source", "graph_sources_of", "PlacementLearner",
+           "placement_learner", "placement_fit",
            "placement_nets_of", "ProgramLearner", "program_learner", "program_fit"]
 
 _METHODS: dict[str, Method] = {}

@@ -42,7 +42,7 @@ PROGRAM_LEARNERS = {p.name: p for p in [
 ]}
 
 
-# what methods/placing.py's load_context reads (the model pool, the checker, learned support shares and pose rules):
+# what methods/placing.py's load_context reads (the model pool, the checker, learned support shares):
 # a PlanIT search setting (instantiate.samples, ...) reruns none of the methods that only share this context
 CONTEXT_KEYS = ("extract", "floor_contact", "instantiate.checks",
                 "evaluate.collision.penetration")

@@ -16,11 +16,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator, Protocol
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Protocol
 
 import pandas as pd
 
+from ..geometry.meshes import Mesh
 from ..room import RoomInput, Walls
+
+if TYPE_CHECKING:
+    from ..graphs.data import Graph, Vocab
+    from ..learning.fitted import Fitted
 
 
 @dataclass
@@ -36,8 +41,8 @@ class Corpus:
     models: list[Path]
     symmetry: Path
     category_sizes: Path
-    meshes: dict = field(default_factory=dict)  # model id -> (vertices, faces) of the room type's objects
-    box_models: set = field(default_factory=set)  # models measured as their box
+    meshes: dict[str, Mesh] = field(default_factory=dict)  # model id -> (vertices, faces) of the room type's objects
+    box_models: set[str] = field(default_factory=set)  # models measured as their box
 
     def ids(self, *parts: str) -> list[str]:
         """Sorted ids of the kept rooms in the named parts of the split."""
@@ -62,7 +67,7 @@ class Generated:
 @dataclass
 class Task:
     """One method's job for one room type: ``count`` scenes (None: the method's default)."""
-    config: dict
+    config: dict[str, Any]
     method: str
     corpus: Corpus
     graphs: tuple[Path, Path] | None = None  # (nodes, edges) of the method's graph generator
@@ -85,28 +90,28 @@ class Scene:
     walls: Walls
     status: str = "placed"
     reason: str | None = None
-    record: dict = field(default_factory=dict)
-    edges: list = field(default_factory=list)
-    parents: dict = field(default_factory=dict)
+    record: dict[str, Any] = field(default_factory=dict)
+    edges: list[Any] = field(default_factory=list)
+    parents: dict[str, str | None] = field(default_factory=dict)
     own_architecture: bool = False
 
 
 class LayoutGenerator(Protocol):
-    info: dict  # what the method's summary.json records besides its figures (e.g. PlanIT's variant settings)
+    info: dict[str, Any]  # what the method's summary.json records besides its figures (e.g. PlanIT's variant settings)
 
     def generate(self, task: Task) -> Iterator[Scene]:
         """Yield the task's scenes, each in one of the corpus's room architectures."""
 
 
 class GraphGenerator(Protocol):
-    def fit(self, config: dict, vocab, graphs: list, split: dict[str, str], room_type: str, progress_file: Path,
-            threads: int = 1):
+    def fit(self, config: dict[str, Any], vocab: Vocab, graphs: list[Graph], split: dict[str, str], room_type: str,
+            progress_file: Path, threads: int = 1) -> Fitted:
         """Learn from the fit graphs (validation graphs choose when to stop); return a ``learning.fitted.Fitted``
         (typed checkpoint, history, summary, loss curves). ``progress_file`` resumes an interrupted run."""
 
-    def sample(self, config: dict, model: Path, graphs: list, nodes: Path, edges: Path, room_type: str,
+    def sample(self, config: dict[str, Any], model: Path, graphs: list[Graph], nodes: Path, edges: Path, room_type: str,
                spec: Path | None = None, count: int | None = None, threads: int = 1,
-               prefix: str | None = None) -> tuple[list[dict], list[dict], dict]:
+               prefix: str | None = None) -> tuple[list[dict[str, Any]], list[dict[str, Any]], dict[str, Any]]:
         """Graphs in held-out rooms' architectures (or completing the partial graph ``spec``) as generated_nodes /
         generated_edges rows, and a summary of the sampling."""
 
@@ -123,8 +128,8 @@ class GraphSource:
     sample: str
     kind: str
     section: str
-    train_keys: Callable[[dict], list[str]]
-    sample_keys: Callable[[dict], list[str]]
+    train_keys: Callable[[dict[str, Any]], list[str]]
+    sample_keys: Callable[[dict[str, Any]], list[str]]
 
 
 @dataclass(frozen=True)
@@ -135,7 +140,7 @@ class PlacementLearner:
     ``train_keys(config)``: the dotted config keys it reads."""
     name: str
     fit: str
-    train_keys: Callable[[dict], list[str]]
+    train_keys: Callable[[dict[str, Any]], list[str]]
 
 
 @dataclass(frozen=True)
@@ -147,7 +152,7 @@ class ProgramLearner:
     ``train_keys(config)``: the dotted config keys it reads."""
     name: str
     fit: str
-    train_keys: Callable[[dict], list[str]]
+    train_keys: Callable[[dict[str, Any]], list[str]]
 
 
 @dataclass(frozen=True)
@@ -160,6 +165,6 @@ class Method:
     model: str | None = None  # the placement learner whose checkpoint it reads ("cfcn" | "fcn" | "tagger"), or None
     reference: str | None = None  # the method whose rooms it reads, or None
     program: str | None = None  # the program learner whose YAML it reads ("infinigen" | "saog"), or None
-    keys: Callable[[dict, str], list[str]] = lambda config, name: ["seed"]  # the config keys it reads
-    scenes: Callable[[dict, str], int] | None = None  # scenes it generates by default (None: one per held-out room)
+    keys: Callable[[dict[str, Any], str], list[str]] = lambda config, name: ["seed"]  # the config keys it reads
+    scenes: Callable[[dict[str, Any], str], int] | None = None  # scenes it generates by default (None: one per held-out room)
     description: str = ""

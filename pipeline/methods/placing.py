@@ -1,5 +1,6 @@
 """What every layout generator that places objects with the project's placement checks shares (PlanIT's search, the
-string method's assembly): the context of one room type's scenes (model pool, checker, learned support shares) and a searched scene as a :class:`~pipeline.methods.interface.Scene` with its search counts and
+string method's assembly): the context of one room type's scenes (model pool, checker, learned support shares) and
+a searched scene as a :class:`~pipeline.methods.interface.Scene` with its search counts and
 graph consistency. No torch."""
 from __future__ import annotations
 

@@ -8,9 +8,9 @@ import numpy as np
 
 from ..evaluation import render
 from ..placement.layout import walls_of
+from ..placement.search import SCORED
 from ..room import RoomInput, room_inputs
 from .interface import Scene, Task
-from ..placement.search import SCORED
 
 
 class Retrieval:

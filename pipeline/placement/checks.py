@@ -10,10 +10,10 @@ import numpy as np
 import shapely
 
 from ..extraction import extract_room
-from ..room import RoomInput
-from ..geometry.collision import deepest_penetration
 from ..geometry import boxes
+from ..geometry.collision import deepest_penetration
 from ..geometry.polygon import door_zones, outside_area
+from ..room import RoomInput
 from .plan import PlanEdge
 
 AREA_EPS = 1e-4  # m^2: overlaps of polygons under 1 cm^2 are numerical

@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..room import RoomInput, Walls, wall_footprints
 from ..geometry import meshes
 from ..geometry.boxes import footprint_corners
+from ..geometry.polygon import nearest_segment
+from ..room import RoomInput, Walls, wall_footprints
 from .plan import PlanEdge
 
 EDGE_COLOURS = {"support": "black", "adjacent": "tab:red", "proximal": "tab:orange", "distant": "tab:blue"}
@@ -43,8 +44,7 @@ def opening_mesh(opening: dict, walls: Walls) -> meshes.Mesh:
     d = (p1 - p0) / max(length, 1e-9)
     normal, thick = np.array([-d[1], d[0]]), DEFAULT_THICKNESS
     if len(walls.ids):
-        t = np.clip(np.einsum("wi,wi->w", mid - walls.a, walls.dir) / walls.length, 0.0, 1.0)
-        k = int(np.argmin(np.linalg.norm(walls.a + t[:, None] * (walls.b - walls.a) - mid, axis=1)))
+        k = int(nearest_segment(mid, walls.segments)[1])
         normal = normal if normal @ walls.normal[k] >= 0 else -normal
         thick = float(walls.thickness[k])
     if opening.get("thickness") is not None and np.isfinite(opening["thickness"]):

@@ -7,9 +7,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..room import RoomInput, Walls, merge_walls
 from ..geometry import raster
 from ..geometry.frames import Frame, boxes_to_local, to_local
+from ..room import RoomInput, Walls, merge_walls
 
 
 @dataclass(frozen=True)

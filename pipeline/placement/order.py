@@ -72,8 +72,8 @@ def placement_order(plan: ScenePlan, mean_area: dict[str, float], constrained: b
         return [int(k) for k in rng.permutation(np.flatnonzero(~tier2))] + [int(k) for k in rng.permutation(np.flatnonzero(tier2))]
     c_in, c_out = constraint_scores(plan, mean_area)
     pos = {v: k for k, v in enumerate(plan.ids)}
-    anchors = [set() for _ in range(n)]
-    spokes = [[] for _ in range(n)]
+    anchors: list[set[int]] = [set() for _ in range(n)]
+    spokes: list[list[int]] = [[] for _ in range(n)]
     for e in plan.edges:
         s, t = pos.get(e.source), pos.get(e.target)
         if s is not None and t is not None:

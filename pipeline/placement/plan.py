@@ -7,6 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from ..seeding import rng_for
+
 DISTANCE_WEIGHT = {"adjacent": 3.0, "proximal": 2.0, "distant": 1.0}  # PlanIT's C_in weights; support counts as adjacent
 
 
@@ -48,7 +50,7 @@ def plans_from_tables(nodes: pd.DataFrame, edges: pd.DataFrame, pruning: str = "
     first ``limit`` scenes only when given. ``pruning``: full (kept edges), none (pruned spatial edges too: the
     paper's no-pruning ablation) or half (a seeded half of the pruned ones, drawn over the whole table)."""
     scene_col = "scene_id" if "scene_id" in nodes.columns else "room_id"
-    rng = np.random.default_rng([seed, 31])
+    rng = rng_for(seed, "plan-pruning")
     status = edges["status"].astype(str).to_numpy() if "status" in edges.columns else np.full(len(edges), "kept")
     take = status == "kept"
     if pruning != "full":

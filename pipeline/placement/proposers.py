@@ -13,7 +13,7 @@ import numpy as np
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d
 from ..geometry.frames import to_local
-from ..geometry.polygon import segment_distances
+from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import Anchor
 from .layout import wall_frame
@@ -59,7 +59,8 @@ class Grid:
 
 
 def nearest_wall(walls: Walls, xy: np.ndarray) -> int:
-    return int(np.argmin(segment_distances(np.asarray(xy, float), np.stack([walls.a, walls.b], 1))))
+    """Index of the wall nearest to plan point ``xy (2,)``."""
+    return int(nearest_segment(np.asarray(xy, float), walls.segments)[1])
 
 
 class DensityProposer:

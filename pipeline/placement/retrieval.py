@@ -8,8 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..room import BOX_COLUMNS
 from ..geometry.boxes import rotation
+from ..room import BOX_COLUMNS
 
 
 @dataclass(frozen=True)

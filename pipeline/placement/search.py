@@ -32,8 +32,9 @@ from typing import Protocol
 
 import numpy as np
 
-from ..room import RoomInput, Walls
 from ..geometry.boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
+from ..geometry.relations import in_footprint
+from ..room import RoomInput, Walls
 from .anchors import Anchor, anchors_of, planned_edges
 from .checks import Checker, check
 from .layout import add_object, with_objects
@@ -134,11 +135,9 @@ def tolerance(failures: float, start: float, full: float) -> float:
 
 def _in_box(points: np.ndarray, b: np.ndarray, inset=(0.0, 0.0), least: float = 0.0) -> np.ndarray:
     """``(m,)`` points inside box ``b (7,)``'s footprint shrunk by ``inset`` (x, y) m in its frame, each half extent
-    kept >= ``least`` m; for boxes ``b (k, 7)``, ``(k, m)``."""
+    kept >= ``least`` m; for boxes ``b (k, 7)``, ``(k, m)`` (``geometry.relations.in_footprint``)."""
     boxes = np.asarray(b, float).reshape(-1, 7)
-    local = (points[None] - boxes[:, None, :2]) @ rotation(boxes[:, 6])  # (k, m, 2)
-    inside = np.abs(local) <= np.maximum(boxes[:, 3:5] - np.asarray(inset, float), least)[:, None, :]
-    out = inside[..., 0] & inside[..., 1]
+    out = in_footprint(points[None], boxes[:, None], inset, least)
     return out if np.ndim(b) == 2 else out[0]
 
 

@@ -5,7 +5,7 @@ of the rooms' share is at least ``min_share``."""
 from __future__ import annotations
 
 from collections import Counter
-from typing import Iterable
+from typing import Any, Iterable
 
 import numpy as np
 
@@ -19,7 +19,7 @@ def wilson_lower(passed: int, total: int, z: float = 1.96) -> float:
     return float((centre - z * np.sqrt(p * (1 - p) / total + z * z / (4 * total * total))) / (1 + z * z / total))
 
 
-def learn_contents(rooms: Iterable[Iterable[str]], min_share: float) -> dict:
+def learn_contents(rooms: Iterable[Iterable[str]], min_share: float) -> dict[str, Any]:
     """From each training room's object categories: ``max_count`` (category -> its largest count in one room) and
     ``required`` (the sorted categories whose share of rooms is confidently >= ``min_share``)."""
     counts = [Counter(r) for r in rooms]
@@ -28,7 +28,7 @@ def learn_contents(rooms: Iterable[Iterable[str]], min_share: float) -> dict:
     return {"max_count": {c: max(k[c] for k in counts) for c in cats}, "required": required}
 
 
-def implausible(categories: Iterable[str], contents: dict) -> tuple[list[str], list[str]]:
+def implausible(categories: Iterable[str], contents: dict[str, Any]) -> tuple[list[str], list[str]]:
     """The categories a room holds more often than any training room (or never seen), and the required ones it
     lacks."""
     counts = Counter(categories)

@@ -54,7 +54,8 @@ def room_inputs(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.Dat
             boxes=o_box[so].reshape(-1, 7), poses=o_pose[so].reshape(-1, 7))
 
 
-def load_rooms(rooms: list[Path], architecture: list[Path], objects: list[Path], ids: set[str] | None = None):
+def load_rooms(rooms: list[Path], architecture: list[Path], objects: list[Path],
+               ids: set[str] | None = None) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame, dict[str, RoomInput]]:
     """Canonical rows of the kept rooms (``ids``: only these) over every shard, as one RoomInput per room."""
     flt = [("room_id", "in", sorted(ids))] if ids is not None else None
     room_df = pd.concat([tables.read(p, "rooms", filters=flt).to_pandas() for p in rooms], ignore_index=True)

@@ -3,6 +3,7 @@ and the column order of object boxes and poses in the canonical tables. Pure dat
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 
@@ -22,7 +23,7 @@ class RoomInput:
     wall_ids: list[str]
     wall_segments: np.ndarray  # (w, 2, 2) inner faces
     wall_thickness: np.ndarray  # (w,)
-    openings: list[dict]  # element_id, kind, x0, y0, x1, y1, z0, z1
+    openings: list[dict[str, Any]]  # element_id, kind, x0, y0, x1, y1, z0, z1
     object_ids: list[str]
     categories: list[str]
     model_ids: list[str]
@@ -42,11 +43,16 @@ class Walls:
 
     @property
     def length(self) -> np.ndarray:
-        return np.linalg.norm(self.b - self.a, axis=1)
+        return cast(np.ndarray, np.linalg.norm(self.b - self.a, axis=1))
 
     @property
     def dir(self) -> np.ndarray:
-        return (self.b - self.a) / self.length[:, None]
+        return cast(np.ndarray, (self.b - self.a) / self.length[:, None])
+
+    @property
+    def segments(self) -> np.ndarray:
+        """``(w, 2, 2)`` inner faces, start to end."""
+        return np.stack([self.a, self.b], 1)
 
 
 def merge_walls(segs: np.ndarray, ids: list[str], thick: np.ndarray, height: float, tol: float = 1e-3) -> Walls:

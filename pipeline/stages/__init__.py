@@ -81,8 +81,10 @@ _ALL = [
                                                  one("sample_summary")),
           outputs=(one("metrics"),), params=(ROOM_TYPE, GENERATOR)),
     Stage("train_placement", "Train one placement learner of one room type: PlanIT's location and orientation "
-          "networks, or the string method's edge tagger (resumes from the checkpoint beside --out-model).", inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT), outputs=TRAINING,
-          params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned), fcn (the unconditional ablation) or tagger (the string method's edge tagger)")),
+          "networks, or the string method's edge tagger (resumes from the checkpoint beside --out-model).",
+          inputs=(*CORPUS_SHARDS[:3], *GRAPHS, SPLIT), outputs=TRAINING,
+          params=(ROOM_TYPE, Param("net", help="cfcn (FiLM-conditioned), fcn (the unconditional ablation) or tagger (the string "
+                                              "method's edge tagger)")),
           threads=True),
     Stage("learn_program", "Learn one room type's readable program from its training rooms: Infinigen's constraint "
           "program (derived from the final graphs' statistics) or S-AOG's grammar (with its weights).",

@@ -1,7 +1,6 @@
 """Graph report (per corpus): Table-1 statistics, pruning by rule and frequent relations as CSV, and one PNG."""
 from __future__ import annotations
 
-
 from ..graphs.report import graph_report, write_report
 from ..stage import Files
 

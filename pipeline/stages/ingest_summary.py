@@ -9,7 +9,6 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.compute  # noqa: F401  (pa.compute)
 
-
 from .. import duck, tables
 from ..errors import InputError
 from ..stage import Files

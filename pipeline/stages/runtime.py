@@ -47,14 +47,43 @@ def per_rule(jobs: pd.DataFrame) -> pd.DataFrame:
     return out.round({"job_seconds": 1, "peak_rss_mb": 0, "share": 3})
 
 
+def per_method(jobs: pd.DataFrame, rules: dict[str, float]) -> pd.DataFrame:
+    """Job seconds per (rule, method) for the rules in ``rules`` whose jobs are named ``<room type>-<method>``: the
+    slowest room type's seconds beside the budget ``rules[rule]`` (seconds per method and room type)."""
+    picked = jobs[jobs.rule.isin(list(rules)) & jobs.job.str.contains("-")]
+    if picked.empty:
+        return pd.DataFrame(columns=["rule", "jobs", "job_seconds", "peak_rss_mb", "budget_seconds"])
+    method = picked.job.str.split("-", n=1).str[1]
+    g = picked.assign(rule=picked.rule + "/" + method).groupby("rule").agg(
+        jobs=("job", "size"), job_seconds=("seconds", "sum"), slowest_type=("seconds", "max"),
+        peak_rss_mb=("max_rss_mb", "max")).reset_index()
+    g["budget_seconds"] = [rules[r.split("/")[0]] for r in g.rule]
+    g["over_budget"] = g.slowest_type > g.budget_seconds
+    return g.sort_values("job_seconds", ascending=False)
+
+
+def with_budgets(table: pd.DataFrame, budget: dict) -> pd.DataFrame:
+    """``per_rule``'s table with each row's budget (config ``runtime``) and whether the run passed it."""
+    rules = {WALL: budget["wall_seconds"], TOTAL: budget["job_seconds"], **budget["rules"]}
+    out = table.assign(budget_seconds=[rules.get(r, float("nan")) for r in table.rule])
+    out["over_budget"] = out.job_seconds > out.budget_seconds
+    return out
+
+
 def run(config: dict, inp: Files, outputs: Files, benchmarks: str) -> pd.DataFrame:
     out = outputs.table
-    benchmarks = Path(benchmarks)
-    table = per_rule(read_benchmarks(benchmarks))
+    budget = config["runtime"]
+    jobs = read_benchmarks(Path(benchmarks))
+    table = with_budgets(per_rule(jobs), budget)
+    methods = per_method(jobs, budget["per_method"])
+    table = pd.concat([table, methods.drop(columns="slowest_type", errors="ignore")], ignore_index=True)
     tables.write_csv(out, table)
-    write_table_html(outputs.table_html, table, "Run time per rule",
-                     f"The wall-clock span, all job seconds, then per rule (slowest first). The same rows are in "
-                     f"{out.name}.", notes={"share": "share of all job seconds"})
+    write_table_html(outputs.table_html, table, "Run time per rule, against its budget",
+                     f"The wall-clock span, all job seconds, then per rule (slowest first), each beside its budget "
+                     f"(config runtime, docs/benchmarks.md); then per method within "
+                     f"{', '.join(budget['per_method'])} (budget: seconds per method and room type). The same rows "
+                     f"are in {out.name}.", notes={"share": "share of all job seconds",
+                                                   "over_budget": "job seconds above the budget"})
     for row in table.head(8).itertuples(index=False):
-        log.info("  %-48s %4d jobs %8.1f s", row.rule, row.jobs, row.job_seconds)
+        log.info("  %-48s %4d jobs %8.1f s (budget %s)", row.rule, row.jobs, row.job_seconds, row.budget_seconds)
     return table

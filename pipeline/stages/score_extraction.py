@@ -18,7 +18,7 @@ def run(config: dict, inp: Files, outputs: Files) -> dict:
     if not len(nodes) == len(edges) == len(ground_truth):
         raise tables.TableError(f"score: {len(nodes)} node, {len(edges)} edge and {len(ground_truth)} ground-truth "
                                 "tables: one of each per shard")
-    counts = Counter()
+    counts: Counter[str] = Counter()
     for n, e, g in zip(nodes, edges, ground_truth):
         node_df = tables.read(n, "nodes").to_pandas()
         ids = node_df["room_id"].unique().tolist()

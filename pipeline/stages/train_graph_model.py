@@ -1,4 +1,5 @@
-"""Train a graph generator (PlanIT's graph model, the string VAE) of one room type on the final graphs of its fit split (kept edges); one job per room type."""
+"""Train a graph generator (PlanIT's graph model, the string VAE) of one room type on the final graphs of its fit split
+(kept edges); one job per room type."""
 from __future__ import annotations
 
 from ..graphs.files import read_split, room_graphs

@@ -35,6 +35,7 @@ import numpy as np
 
 from ...geometry.boxes import footprint_corners, to_local
 from ...geometry.polygon import polygon_segments
+from ...geometry.relations import parent_cycles
 from ...room import RoomInput
 from . import relpos
 
@@ -113,14 +114,8 @@ def support_forest(ids: list[str], parents: dict[str, str | None],
     smallest id), which goes to the floor."""
     known, size = set(ids), size or {}
     par = {i: (p if p in known and p != i else None) for i, p in ((i, parents.get(i)) for i in ids)}
-    for start in sorted(ids):
-        seen, i = [], start
-        while i is not None and i not in seen:
-            seen.append(i)
-            i = par[i]
-        if i is not None:  # i closes a loop
-            loop = seen[seen.index(i):]
-            par[min(loop, key=lambda j: (-size.get(j, 0.0), j))] = None
+    for loop in parent_cycles({i: par[i] for i in sorted(ids)}):
+        par[min(loop, key=lambda j: (-size.get(j, 0.0), j))] = None
     return par
 
 

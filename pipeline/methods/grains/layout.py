@@ -8,7 +8,6 @@ root decodes (:func:`.hierarchy.decoded_room`: no doors or windows), written as 
 from __future__ import annotations
 
 import time
-import zlib
 from typing import Iterator
 
 import torch
@@ -18,6 +17,7 @@ from ...log import progress
 from ...placement.layout import add_object, walls_of, with_objects
 from ...placement.retrieval import ModelPool, nearest, place
 from ...room import RoomInput
+from ...seeding import seed_of
 from ..interface import Scene, Task
 from ..placing import load_context
 from .hierarchy import Node, anchor, decoded_room, layout, leaves, room_rect
@@ -87,7 +87,7 @@ class GrainsLayout:
         if not rooms:
             return
         # one seed for both modes: grains and grains_decoded furnish the same trees, in different rooms
-        gen = torch.Generator().manual_seed(zlib.crc32(f"{self.config['seed']}/grains".encode()))
+        gen = torch.Generator().manual_seed(seed_of(self.config["seed"], "grains"))
         start = time.perf_counter()
         trees = model.decode(torch.randn(count, model.sizes.root_feature, generator=gen), self.cfg["max_depth"])
         decode_s = (time.perf_counter() - start) / count  # decoded in one batch: each scene's share

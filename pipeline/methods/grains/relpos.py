@@ -31,6 +31,7 @@ import math
 import numpy as np
 
 from ...geometry.boxes import rotation
+from ...geometry.frames import wrap
 
 CODE = 28
 SIDES = ("front", "back", "left", "right")   # local +y, -y, -x, +x
@@ -45,12 +46,6 @@ X_EDGES, Y_EDGES = (2, 3), (0, 1)  # SIDES indices of left/right and front/back
 _SIGN = {0: 1.0, 1: -1.0, 2: -1.0, 3: 1.0}  # the side's direction along its axis
 
 
-def wrap(angle: float) -> float:
-    """An angle (rad) wrapped into ``[-pi, pi)``."""
-    out = float((angle + math.pi) % (2 * math.pi) - math.pi)
-    return out - 2 * math.pi if out >= math.pi else out
-
-
 def extents(rot: float, half: np.ndarray) -> np.ndarray:
     """``(2,)`` half sizes (m) of the bound, in a frame turned ``rot`` (rad) from the box's, of a box of ``half``."""
     return np.abs(rotation(rot)) @ np.asarray(half, float)[:2]
@@ -59,7 +54,7 @@ def extents(rot: float, half: np.ndarray) -> np.ndarray:
 def relative(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, float]:
     """``b``'s centre ``(2,)`` in ``a``'s frame (m) and its yaw relative to ``a`` (rad, wrapped)."""
     d = rotation(float(a[6])).T @ (np.asarray(b[:2], float) - np.asarray(a[:2], float))
-    return d, wrap(float(b[6]) - float(a[6]))
+    return d, float(wrap(float(b[6]) - float(a[6])))
 
 
 def _best_pair(centre: float, ext: float, half_a: float, edges: tuple[int, int]) -> tuple[int, int, float]:
@@ -150,4 +145,4 @@ def decode(a: np.ndarray, half_b: np.ndarray, code: np.ndarray, snap: bool = Fal
     if snap:
         dx, dy = snapped(code, np.array([dx, dy]), ext, a[3:5], np.asarray(half_b, float))
     c = a[:2] + rotation(float(a[6])) @ np.array([dx, dy])
-    return float(c[0]), float(c[1]), wrap(float(a[6]) + rot)
+    return float(c[0]), float(c[1]), float(wrap(float(a[6]) + rot))

@@ -22,11 +22,11 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import torch
 
 from ...evaluation.distributions import category_kl
 from ...learning import epochs
+from ...seeding import rng_for
 from .hierarchy import Node, leaves
 from .model import GrainsVAE, Sizes
 
@@ -51,7 +51,7 @@ def build_model(labels: list[str], preset: dict) -> GrainsVAE:
 
 def _epoch(model: GrainsVAE, opt, trees: list[Node], preset: dict, seed: int, epoch: int) -> tuple[float, float]:
     """One pass over ``trees`` in shuffled mini-batches; the mean total loss and KL per tree."""
-    order = np.random.default_rng([seed, epoch]).permutation(len(trees))
+    order = rng_for(seed, epoch).permutation(len(trees))
     gen = torch.Generator().manual_seed(int(seed) * 100_003 + epoch)
     total = kl = 0.0
     model.train()

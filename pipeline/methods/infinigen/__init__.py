@@ -4,8 +4,7 @@
 pass it back (``planit generate --method infinigen --program FILE``)."""
 from __future__ import annotations
 
-from .program import (DEFAULT_WEIGHTS, STAGES, TERMS, ObjectRule, Program, dump_program, load_program,
-                      parse_program)
+from .program import DEFAULT_WEIGHTS, STAGES, TERMS, ObjectRule, Program, dump_program, load_program, parse_program
 
 __all__ = ["DEFAULT_WEIGHTS", "STAGES", "TERMS", "ObjectRule", "Program", "dump_program", "load_program",
            "parse_program"]

@@ -10,12 +10,13 @@ import shapely
 
 from ...evaluation.walkability import walkability
 from ...geometry import boxes as gb
+from ...geometry.polygon import nearest_segment
 from ...placement.checks import AREA_EPS
 from ...placement.retrieval import ModelPool
 from ..solver import operators as op
 from ..solver.moves import Spec
 from ..solver.state import State, wall_yaw
-from ..solver.terms import Term, footprints, front_of, gaps, nearest_wall
+from ..solver.terms import Term, footprints, front_of, gaps
 from .program import Program
 
 
@@ -100,7 +101,7 @@ def alignment(state: State) -> float:
     free = [k for k, it in enumerate(state.items) if it.dof == "floor"]
     if not free:
         return 0.0
-    _, w = nearest_wall(state, state.boxes[free, :2])
+    _, w = nearest_segment(state.boxes[free, :2], state.walls.segments)
     ref = [wall_yaw(state.walls, int(j)) for j in w]
     return op.alignment_cost(state.boxes[free, 6], ref, period=np.pi / 2)
 

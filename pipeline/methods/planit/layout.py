@@ -4,7 +4,6 @@ baselines) or per Table 3 ablation (held-out rooms' own graphs)."""
 from __future__ import annotations
 
 import logging
-import zlib
 from dataclasses import replace
 from pathlib import Path
 from typing import Iterator
@@ -19,10 +18,11 @@ from ...log import progress
 from ...placement import order, proposers
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
+from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from ...placement.search import SCORED, instantiate
+from ...seeding import seed_of
 from ..interface import Corpus, Scene, Task
 from ..placing import Context, load_context, scene_of
-from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from .nets.proposer import NetProposer
 from .nets.train import KIND
 
@@ -116,7 +116,7 @@ class PlanitLayout:
         for plan in plans:
             if scored >= count:
                 break
-            seed = zlib.crc32(f"{self.config['seed']}/{self.name}/{plan.scene_id}".encode())
+            seed = seed_of(self.config["seed"], self.name, plan.scene_id)
             outcome, walls = place_scene(plan, ctx, proposer, self.settings, self.variant, seed)
             scored += outcome.status in SCORED
             next(bar, None) if outcome.status in SCORED else None
@@ -145,6 +145,6 @@ class CompleteRoom:
         saved = checkpoint.load(task.model, KIND)
         ctx = load_context(self.config, task.corpus)
         proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"])
-        seed = zlib.crc32(f"{self.config['seed']}/complete/{plan.scene_id}".encode())
+        seed = seed_of(self.config["seed"], "complete", plan.scene_id)
         outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)
         yield scene_of(plan, ctx, outcome, walls)

@@ -10,16 +10,16 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from ...geometry.polygon import nearest_segment
 from ...placement.layout import walls_of
 from ...placement.retrieval import Instance, ModelPool
 from ...room import BOX_COLUMNS, POSE_COLUMNS, RoomInput
 from ..solver.harness import limits_of
 from ..solver.state import Item, State, empty_state, wall_yaw
-from ..solver.terms import Hard, nearest_wall
+from ..solver.terms import Hard
 from .potentials import POTENTIALS, features
 from .sample import sample_room
-from .stats import (affordance_map, contrastive_divergence, fit_lognormal, fit_size_kde, fit_von_mises_mixture,
-                    learn_set)
+from .stats import affordance_map, contrastive_divergence, fit_lognormal, fit_size_kde, fit_von_mises_mixture, learn_set
 
 NO_INSTANCE = Instance("", (0.1, 0.1, 0.1), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), 0.0)
 
@@ -49,7 +49,7 @@ def wall_fits(states: list[State], cfg: dict) -> dict[str, dict]:
         ks = [k for k, it in enumerate(s.items) if it.parent < 0]
         if not ks:
             continue
-        d, w = nearest_wall(s, s.boxes[ks, :2])
+        d, w = nearest_segment(s.boxes[ks, :2], s.walls.segments)
         for i, k in enumerate(ks):
             c = s.items[k].category
             dist.setdefault(c, []).append(max(d[i] - s.boxes[k, 4], 0.0))

@@ -8,8 +8,9 @@ from __future__ import annotations
 import numpy as np
 
 from ...geometry.boxes import to_local
+from ...geometry.polygon import nearest_segment
 from ..solver.state import State, wall_yaw
-from ..solver.terms import Term, nearest_wall
+from ..solver.terms import Term
 from .stats import affordance_energy, lognormal_energy, von_mises_energy
 
 POTENTIALS = ("wall_distance", "wall_angle", "group", "affordance")
@@ -22,7 +23,7 @@ def wall_features(state: State, grammar: dict) -> tuple[float, float]:
     if not ks:
         return 0.0, 0.0
     b = state.boxes[ks]
-    dist, w = nearest_wall(state, b[:, :2])
+    dist, w = nearest_segment(b[:, :2], state.walls.segments)
     back = np.maximum(dist - b[:, 4], 0.0)
     angle = b[:, 6] - np.array([wall_yaw(state.walls, int(j)) for j in w])
     dist_e = sum(float(lognormal_energy(back[i], **cats[state.items[k].category]["wall_distance"]))

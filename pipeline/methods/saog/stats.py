@@ -3,8 +3,9 @@ CVPR 2018), over NumPy arrays; no torch.
 
 - Log-normal fits of distances (section 4.1, the relative-distance potentials of the pairwise and wall terms).
 - Von Mises mixtures of relative orientations (section 4.1; the released code fits mixtures of angles).
-- The grammar's nodes (section 3): Set nodes (how many of a category a room holds) and Or nodes (which branch), learned
-  as branch frequencies (section 4.2, maximum likelihood), drawn from when a room is sampled (section 5).
+- The grammar's Set nodes (section 3: how many of a category a room holds; the paper's Or nodes are flattened away,
+  ``docs/departures.md``), learned as frequencies (section 4.2, maximum likelihood), drawn from when a room is sampled
+  (section 5).
 - Object sizes as a kernel density over the training half-extents (section 4.2).
 - Affordance maps (section 4.1, l_hum; Table 2): where the "humans" (the centres of seats and beds) stand in an
   object's frame, 20 x 20 bins over +-2 m as in the released code.
@@ -13,7 +14,6 @@ CVPR 2018), over NumPy arrays; no torch.
 Angles are in radians, lengths in metres. Energies are negative log densities."""
 from __future__ import annotations
 
-from collections import Counter
 from collections.abc import Callable
 
 import numpy as np
@@ -117,29 +117,9 @@ def learn_set(counts: np.ndarray, max_count: int | None = None) -> dict:
     return {"values": [int(v) for v in values], "probs": [float(f) for f in freq / c.size]}
 
 
-def learn_or(choices: list[str]) -> dict:
-    """An Or node: the branch frequencies of ``choices`` (one branch name per observation).
-    Returns ``{"branches": sorted names, "probs": floats}``."""
-    if not choices:
-        raise ValueError("learn_or needs at least one choice")
-    seen = Counter(choices)
-    branches = sorted(seen)
-    return {"branches": branches, "probs": [seen[b] / len(choices) for b in branches]}
-
-
-def sample_node(node: dict, rng: np.random.Generator) -> int | str:
-    """One draw from a Set node (an int count) or an Or node (a branch name)."""
-    if "values" in node:
-        return int(node["values"][rng.choice(len(node["values"]), p=node["probs"])])
-    if "branches" in node:
-        return str(node["branches"][rng.choice(len(node["branches"]), p=node["probs"])])
-    raise ValueError("a grammar node has either 'values' (Set) or 'branches' (Or)")
-
-
-def branch_stderr(probs: np.ndarray, n: int) -> np.ndarray:
-    """Binomial standard error sqrt(p(1-p)/n) of frequencies ``probs`` learned from ``n`` observations."""
-    p = np.asarray(probs, dtype=float)
-    return np.sqrt(p * (1 - p) / n)
+def sample_node(node: dict, rng: np.random.Generator) -> int:
+    """One draw from a Set node: a count."""
+    return int(node["values"][rng.choice(len(node["values"]), p=node["probs"])])
 
 
 # ---------------------------------------------------------------- sizes by kernel density (section 4.2)
@@ -187,12 +167,6 @@ def affordance_map(local_xy: np.ndarray, bins: int = 20, extent: float = 2.0, pr
     return amap / total if total > 0 else np.full((bins, bins), 1.0 / bins ** 2)
 
 
-def affordance_bin(xy, bins: int = 20, extent: float = 2.0) -> tuple[int, int] | None:
-    """(row, col) of the cell holding the point ``xy`` (2,) (m, object frame), or None outside +-``extent``."""
-    rows, cols, inside = _bin_index(np.asarray(xy, dtype=float).reshape(1, 2), bins, extent)
-    return (int(rows[0]), int(cols[0])) if inside[0] else None
-
-
 def affordance_energy(amap: np.ndarray, local_xy: np.ndarray, extent: float = 2.0,
                       outside: float | None = None, floor: float = 1e-12) -> float:
     """l_hum: -log of the best map value over the humans ``local_xy`` (n, 2) (m, object frame); a point outside the
@@ -205,11 +179,6 @@ def affordance_energy(amap: np.ndarray, local_xy: np.ndarray, extent: float = 2.
     fallback = float(amap.min()) if outside is None else outside
     values = np.where(inside, amap[rows, cols], fallback)
     return float(-np.log(max(values.max(), floor)))
-
-
-def affordance_tv(a: np.ndarray, b: np.ndarray) -> float:
-    """Total variation 0.5 * sum |a - b| between two normalised maps of the same shape (Table 2)."""
-    return float(0.5 * np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)).sum())
 
 
 # ---------------------------------------------------------------- contrastive divergence (section 4.2, eq. 21)

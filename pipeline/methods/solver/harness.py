@@ -3,7 +3,6 @@ method generates into (the held-out architectures, in turn) and the loop that so
 from __future__ import annotations
 
 import time
-import zlib
 from typing import Callable, Iterator
 
 import numpy as np
@@ -11,6 +10,7 @@ import numpy as np
 from ...log import progress
 from ...placement.layout import walls_of
 from ...placement.retrieval import ModelPool
+from ...seeding import seed_of
 from ..interface import Scene, Task
 from .anneal import Chain
 from .moves import Steps
@@ -44,7 +44,7 @@ def solve_rooms(config: dict, task: Task, name: str, count: int,
     for i in progress(range(count if rooms else 0), total=count, desc=f"{name} {task.corpus.room_type}"):
         room = rooms[i % len(rooms)]
         scene_id = f"gen_{task.corpus.room_type}_{i:05d}"
-        rng = np.random.default_rng(zlib.crc32(f"{config['seed']}/{name}/{scene_id}".encode()))
+        rng = np.random.default_rng(seed_of(config["seed"], name, scene_id))
         state = empty_state(room, walls_of(room))
         hard = Hard(state, limits)
         start = time.perf_counter()

@@ -8,8 +8,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...placement.retrieval import ModelPool
 from ...geometry.polygon import poke_out
+from ...placement.retrieval import ModelPool
 from .state import Item, State, top_range, wall_range
 
 MOVES = ("translate", "rotate", "replane", "swap", "add", "delete", "resample", "reinit")

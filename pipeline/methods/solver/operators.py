@@ -7,11 +7,6 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 
-def wrap(angle):
-    """Angles in ``[-pi, pi)``."""
-    return (np.asarray(angle, float) + np.pi) % (2 * np.pi) - np.pi
-
-
 def alignment_cost(yaw: np.ndarray, reference: np.ndarray, period: float = 2 * np.pi) -> float:
     """Infinigen's angle alignment: the sum over objects of ``(1 - cos theta) / 2``, ``theta`` the angle from each
     ``yaw (n,)`` to its ``reference (n,)`` measured with the given period (``pi / 2``: any wall axis)."""

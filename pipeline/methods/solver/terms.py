@@ -12,6 +12,7 @@ import numpy as np
 import shapely
 
 from ...geometry import boxes as gb
+from ...geometry.function import footprint_gaps
 from ...geometry.polygon import door_zones, outside_area
 from ...placement.checks import AREA_EPS, support_shares
 from .state import State
@@ -89,7 +90,7 @@ class Hard:
                 door = shapely.area(shapely.intersection(shapely.polygons(corners), self.zones)) > AREA_EPS
         on = np.array([k for k, it in enumerate(state.items) if it.parent >= 0], int)
         parents = np.array([state.items[k].parent for k in on], int)
-        over = support_shares(state.boxes[on], state.boxes[parents]) < self.limits.min_support if len(on) else []
+        over: np.ndarray | list[bool] = support_shares(state.boxes[on], state.boxes[parents]) < self.limits.min_support if len(on) else []
         return {"collision": colliding_pairs(state, self.limits.collision)[:, 1].tolist(),
                 "outside": grounded[outside].tolist(), "door": grounded[door].tolist(),
                 "overhang": on[np.asarray(over, bool)].tolist()}
@@ -109,20 +110,10 @@ class Energy:
 
 def gaps(state: State, i: int, js: list[int]) -> np.ndarray:
     """``(len(js),)`` m between item ``i``'s footprint and each of ``js``' (0 where they touch or overlap)."""
-    polys = shapely.polygons(footprints(state.boxes[[i, *js]]))
-    return shapely.distance(polys[0], polys[1:])
+    return footprint_gaps(state.boxes[i], state.boxes[js])[0]
 
 
 def front_of(box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The front face's midpoint ``(2,)`` and outward normal ``(2,)`` of a box ``(7,)``."""
     normal = gb.rotation(box[6]) @ np.array([0.0, 1.0])
     return box[:2] + normal * box[4], normal
-
-
-def nearest_wall(state: State, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For points ``(n, 2)``: the distance (m) to the nearest wall's inner face and that wall's index."""
-    w = state.walls
-    d = w.b - w.a
-    t = np.clip(np.einsum("nwj,wj->nw", xy[:, None] - w.a[None], d) / np.einsum("wj,wj->w", d, d), 0, 1)
-    dist = np.linalg.norm(xy[:, None] - (w.a[None] + t[..., None] * d[None]), axis=-1)
-    return dist.min(1), dist.argmin(1)

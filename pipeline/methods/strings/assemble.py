@@ -21,12 +21,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...graphs.data import edge_class
+from ...placement.anchors import anchors_of, planned_edges
 from ...placement.checks import Checker, check
 from ...placement.layout import add_object, walls_of
 from ...placement.plan import PlanEdge, ScenePlan
-from ...placement.retrieval import ModelPool, place
-from ...placement.anchors import anchors_of, planned_edges
 from ...placement.proposers import Grid
+from ...placement.retrieval import ModelPool, place
 from ...placement.search import Outcome, drop_reason, inside_walls, snap
 from ...room import RoomInput, Walls
 from .poses import anchor_frame, from_relative
@@ -195,7 +195,8 @@ class Assembly:
 def assemble(plan: ScenePlan, room: RoomInput, tags: dict, pool: ModelPool, checker: Checker, cfg: dict,
              icfg: dict, seed: int) -> tuple[Outcome, Walls, int]:
     """Place the plan's objects in ``room`` (its architecture); ``tags``: plan edge key (:func:`key`) -> its clusters
-    ranked; ``cfg``: ``strings.tagger.placement``; ``icfg``: the ``instantiate`` section (snapping, grid). Returns the outcome (the search's record: no backtracks), the walls and the objects placed with no
+    ranked; ``cfg``: ``strings.tagger.placement``; ``icfg``: the ``instantiate`` section (snapping, grid). Returns the
+    outcome (the search's record: no backtracks), the walls and the objects placed with no
     anchor."""
     start, walls = time.perf_counter(), walls_of(room)
     a = Assembly(plan, room, walls, tags, pool, checker, cfg, icfg, np.random.default_rng(seed))

@@ -5,7 +5,6 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import torch
 
@@ -16,6 +15,7 @@ from ...learning.checkpoint import Checkpoint
 from ...learning.device import pick_device
 from ...learning.fitted import Fitted, epoch_figure
 from ...log import progress
+from ...seeding import rng_for
 from . import train
 from .serialize import arch_prefix, string_graph
 from .vocab import learn_vocab
@@ -31,7 +31,7 @@ def token_vocab(fit: list[train.Room], every: list[train.Room], seed: int, prese
     """The tokens of the fit rooms' strings (several orders each), of every room's architecture prefix (the
     architectures a string is conditioned on: held-out rooms' included, their objects not) and a reference to each
     architecture atom."""
-    rng = np.random.default_rng([seed, 0])
+    rng = rng_for(seed, "strings-vocab")
     most = max(n for _, n in every)
     texts = train.room_strings(fit, rng, 4 * preset["strings_per_room"]) + train.room_strings(fit, None)
     return learn_vocab([t for t, _ in texts] + [arch_prefix(g, n)[0] for g, n in every] + [f"@{k}" for k in range(most)])

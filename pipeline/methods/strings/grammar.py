@@ -34,7 +34,7 @@ def bond(out: bool, edge_class: int, neighbour: str, detail: str) -> Bond:
 
 def bonds_of(names, edges, detail: str = "edge") -> list[Counter]:
     """Per node of ``names``, its bonds among ``edges`` (source, target, edge class) at ``detail`` counted."""
-    out = [Counter() for _ in names]
+    out: list[Counter[Bond]] = [Counter() for _ in names]
     for s, t, c in edges:
         out[s][bond(True, c, names[t], detail)] += 1
         out[t][bond(False, c, names[s], detail)] += 1

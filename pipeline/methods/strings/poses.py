@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...graphs.data import EDGE_CLASSES, N_OBJECT_EDGES, Graph, Vocab
+from ...graphs.data import N_OBJECT_EDGES, Graph, Vocab
 from ...placement.prior import anchor_frame, from_relative, relative_pose  # noqa: F401 (from_relative: assemble's)
 from ...room import RoomInput, Walls
 
@@ -122,7 +122,3 @@ def fit_clusters(poses: list[EdgePose], bandwidth: dict) -> Clusters:
         cnt[t], off[t] = np.array([len(g) for g in groups]), k
         k += len(groups)
     return Clusters(cen, spr, cnt, off, dict(bandwidth))
-
-
-def triple_name(t: Triple) -> str:
-    return f"{t[0]} -{EDGE_CLASSES[t[2]]}-> {t[1]}"

@@ -5,7 +5,6 @@ reason and sampled again (a budget). Kept graphs become generated_nodes / genera
 from __future__ import annotations
 
 import logging
-import zlib
 from collections import Counter
 from pathlib import Path
 
@@ -17,8 +16,8 @@ from ...graphs import checks as graph_checks
 from ...graphs.data import ARCH, Graph, Vocab
 from ...graphs.generated import Grown, contents_of, graph_rows, resample
 from ...learning import checkpoint
-from . import sample as decoding
-from . import train
+from ...seeding import seed_of
+from . import sample as decoding, train
 from .grammar import Grammar, learn_grammar
 from .serialize import StringError, arch_prefix, parse, string_graph
 from .vocab import EOS, TokenVocab
@@ -101,7 +100,7 @@ def sample_room_type(config: dict, model: Path, graphs: list[Graph], nodes: Path
     rules = Rules([by_id[i] for i in rec["train_ids"] + rec["validation_ids"] if i in by_id], vocab, sc["grammar"],
                   config["graph_model"]["sample"]["contents"])
     n = count or sc["graphs"]
-    seed = zlib.crc32(f"{config['seed']}/{room_type}/strings".encode())
+    seed = seed_of(config["seed"], room_type, "strings")
     kept, first_try, reasons = _sample_valid(net, tokens, vocab, held, n, sc, rules, seed, room_type)
     rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"strings_{room_type}")
     summary = {"room_type": room_type, "generator": "strings", "requested": n, "written": len(kept),

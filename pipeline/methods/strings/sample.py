@@ -1,7 +1,6 @@
-"""Decoding room strings from the sequence VAE, many at once: codes from the prior, from a training room's code
-perturbed (the paper's section 5.2: up to ``radius`` per dimension) or on a straight path between two rooms' codes
-(32 points in the paper), each decoded after a forced prefix (the room's architecture string and ``.``), token by
-token at a temperature."""
+"""Decoding room strings from the sequence VAE, many at once: codes from the prior or on a straight path between
+two rooms' codes (32 points in the paper), each decoded after a forced prefix (the room's architecture string and
+``.``), token by token at a temperature."""
 from __future__ import annotations
 
 from collections import Counter
@@ -10,9 +9,8 @@ import numpy as np
 import torch
 
 from ...graphs.data import EDGE_CLASSES, N_OBJECT_EDGES
-
-from .model import SeqVAE
 from .grammar import Grammar, bonds_of
+from .model import SeqVAE
 from .serialize import Reader, label_fault
 from .vocab import BOS, EOS, PAD, SPECIAL, TokenVocab
 
@@ -20,11 +18,6 @@ from .vocab import BOS, EOS, PAD, SPECIAL, TokenVocab
 def prior_codes(n: int, latent: int, gen: torch.Generator) -> torch.Tensor:
     """``(n, latent)`` codes from the standard normal prior."""
     return torch.randn(n, latent, generator=gen)
-
-
-def perturbed_codes(mu: torch.Tensor, radius: float, gen: torch.Generator) -> torch.Tensor:
-    """``mu (n, latent)`` moved by up to ``radius`` per dimension (uniform)."""
-    return mu + (torch.rand(mu.shape, generator=gen) * 2 - 1) * radius
 
 
 def path_codes(a: torch.Tensor, b: torch.Tensor, points: int) -> torch.Tensor:

@@ -6,7 +6,6 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import torch
 
@@ -20,6 +19,7 @@ from ...learning.fitted import Fitted, epoch_figure
 from ...log import progress
 from ...placement.layout import walls_of
 from ...room import RoomInput
+from ...seeding import rng_for
 from . import tagger
 from .poses import Clusters, EdgePose, edge_poses, fit_clusters
 from .serialize import arch_prefix, room_string, string_graph
@@ -38,7 +38,7 @@ def tagger_room(g: Graph, vocab: Vocab, poses: list[EdgePose], clusters: Cluster
 
 def token_vocab(fit: list[tagger.Room], every: list[tagger.Room], seed: int, per_room: int):
     """The tokens of several strings of every fit room and of every room's architecture prefix."""
-    rng = np.random.default_rng([seed, 1])
+    rng = rng_for(seed, "tagger-vocab")
     texts = [room_string(r.graph, r.n_arch, rng)[0] for r in fit for _ in range(per_room)]
     return learn_vocab(texts + [arch_prefix(r.graph, r.n_arch)[0] for r in every] +
                        [f"@{k}" for k in range(max((r.n_arch for r in every), default=1))])

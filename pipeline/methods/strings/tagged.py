@@ -4,7 +4,6 @@ the graph), assembled breadth-first from the walls with repair (:mod:`.assemble`
 from __future__ import annotations
 
 import logging
-import zlib
 from pathlib import Path
 from typing import Iterator
 
@@ -18,6 +17,7 @@ from ...learning import checkpoint
 from ...log import progress
 from ...placement.layout import with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
+from ...seeding import seed_of
 from ..interface import Scene, Task
 from ..placing import load_context, scene_of
 from . import tagger
@@ -84,7 +84,7 @@ class TaggedLayout:
         plans, graphs = self.plans(task, vocab)
         pc = self.config["strings"]["tagger"]["placement"]
         for plan in progress(plans, total=len(plans), desc=f"assemble {task.corpus.room_type} ({self.name})"):
-            seed = zlib.crc32(f"{self.config['seed']}/{self.name}/{plan.scene_id}".encode())
+            seed = seed_of(self.config["seed"], self.name, plan.scene_id)
             tags = tags_of(graphs[plan.scene_id], vocab, clusters, model, tokens, rec["preset"]["votes"], seed)
             source = ctx.corpus.inputs[plan.room_id]
             outcome, walls, unanchored = assemble(plan, with_objects(source, []), tags, ctx.pool, ctx.checker, pc,

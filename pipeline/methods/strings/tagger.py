@@ -16,6 +16,7 @@ from torch import nn
 
 from ...graphs.data import N_OBJECT_EDGES
 from ...learning import epochs
+from ...seeding import rng_for
 from .poses import Clusters, Triple
 from .serialize import StringGraph, read_string, room_string
 from .vocab import TokenVocab
@@ -118,7 +119,7 @@ def vote(model: EdgeTagger, room: Room, clusters: Clusters, tokens: TokenVocab, 
          batch_size: int = 64) -> dict[Edge, np.ndarray]:
     """Per edge with a known triple: its clusters' (global indices) probabilities averaged over ``strings`` random
     strings of the room (the canonical one when 1)."""
-    rng = np.random.default_rng([seed, 7]) if strings > 1 else None
+    rng = rng_for(seed, "tagger-votes") if strings > 1 else None
     examples = [example(room, clusters, rng) for _ in range(strings)]
     total: dict[Edge, np.ndarray] = {}
     for ex, p in zip(examples, probabilities(model, examples, tokens, batch_size)):
@@ -178,7 +179,7 @@ def train(fit: list[Room], validation: list[Room], clusters: Clusters, tokens: T
     while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
         epoch = state["epoch"] + 1
         start = time.perf_counter()
-        rng = np.random.default_rng([seed, epoch])
+        rng = rng_for(seed, epoch)
         examples = [example(r, clusters, rng) for r in fit for _ in range(preset["strings_per_room"])]
         loss = _epoch(model, opt, examples, tokens, preset, seed, epoch, device)
         seconds = time.perf_counter() - start

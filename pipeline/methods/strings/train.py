@@ -15,6 +15,7 @@ import numpy as np
 import torch
 
 from ...learning import epochs
+from ...seeding import rng_for
 from .model import SeqVAE, losses
 from .serialize import StringGraph, arch_prefix, serialize_room, tokens
 from .vocab import UNK, TokenVocab
@@ -108,7 +109,7 @@ def train(fit: list[Room], validation: list[Room], vocab: TokenVocab, preset: di
         beta = min(1.0, epoch / max(preset["kl_anneal"], 1))
         start = time.perf_counter()
         model.train()
-        strings = room_strings(fit, np.random.default_rng([seed, epoch]), preset["strings_per_room"])
+        strings = room_strings(fit, rng_for(seed, epoch), preset["strings_per_room"])
         nll, kl = _epoch(model, opt, strings, vocab, preset, beta, seed, epoch, device)
         seconds = time.perf_counter() - start
         val = score(model, val_strings, vocab, preset, device)

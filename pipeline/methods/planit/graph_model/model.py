@@ -17,8 +17,8 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from ....graphs.data import EDGE_CLASSES, N_OBJECT_EDGES, ROLES
 from ....geometry.symmetry import TYPES as SYMMETRIES
+from ....graphs.data import EDGE_CLASSES, N_OBJECT_EDGES, ROLES
 
 EDGE_FEATURES = len(EDGE_CLASSES) + 1  # one-hot class + cos(angle)
 EDGE_CHOICES = 2 * N_OBJECT_EDGES  # per candidate: direction (candidate -> new, new -> candidate) x type

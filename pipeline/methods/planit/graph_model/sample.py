@@ -4,18 +4,17 @@ still invalid are counted, never returned."""
 from __future__ import annotations
 
 import logging
-import zlib
 from collections import Counter
 from pathlib import Path
 
 import torch
 
 from ....errors import InputError
-from ....graphs import checks as graph_checks
-from ....graphs import data as graph_data
+from ....graphs import checks as graph_checks, data as graph_data
 from ....graphs.data import ARCH
 from ....graphs.generated import contents_of, graph_rows, resample
 from ....learning import checkpoint
+from ....seeding import seed_of
 from . import train
 from .sampler import sample
 from .spec import load_spec
@@ -61,7 +60,7 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     if not held:
         raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
     n = count or sc["graphs"]
-    base_seed = zlib.crc32(f"{config['seed']}/{room_type}/{Path(spec).name if spec else ''}".encode())
+    base_seed = seed_of(config["seed"], room_type, Path(spec).name if spec else "")
     kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, (seen, caps, required, opposite_ok), plan, base_seed,
                                              saved["max_edges"], room_type)
     rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"gen_{room_type}")

@@ -15,8 +15,8 @@ import torch
 import torch.nn.functional as F
 
 from ....graphs import checks as graph_checks
-from ....graphs.generated import Grown
 from ....graphs.data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, features, node_features
+from ....graphs.generated import Grown
 from .model import EDGE_CHOICES, GraphModel
 from .teacher import candidate_logits, edge_features
 
@@ -218,7 +218,7 @@ def _order_mask(st: _State, graphs, width) -> torch.Tensor:
         g = st.grown[b]
         n_arch, me = g.arch.n_arch, len(g.node_class) - 1
         down, up, has_parent = {me}, {me}, set()
-        for s, t, c in g.edges:
+        for _s, t, c in g.edges:
             if c == 0:
                 has_parent.add(t)
         changed = True
@@ -236,7 +236,7 @@ def _order_mask(st: _State, graphs, width) -> torch.Tensor:
             mask[r, u, 0, :] = True  # u -> me would close a cycle
         for u in up - {me}:
             mask[r, u, 1, :] = True  # me -> u would close a cycle
-        for s, t, c in g.edges:  # a pair already joined: no second edge either way
+        for s, t, _c in g.edges:  # a pair already joined: no second edge either way
             u = s if t == me else t if s == me else None
             if u is not None and u < width:
                 mask[r, u] = True

@@ -79,7 +79,9 @@ def _events(seq: Sequence, n_cats: int, base: int, b: int, decisions: list, chos
 def make_batch(seqs: list[Sequence], vocab: Vocab, device: str = "cpu") -> Batch:
     """Tensors for a batch of sequences (architecture edges present from the start)."""
     n_cats = len(vocab.categories)
-    xs, arch, graph, local, appear, edges, events, decisions, chosen = [], [], [], [], [], [], [], [], []
+    xs, arch, graph, local, appear, edges, events = [], [], [], [], [], [], []
+    decisions: list[tuple[int, int, int]] = []  # (graph, event row, edge code or -1)
+    chosen: list[tuple[int, int]] = []  # (decision, an edge code chosen before it)
     base = 0
     for b, seq in enumerate(seqs):
         g, n = seq.graph, len(seq.order)

@@ -4,7 +4,8 @@ resume.
 Every epoch draws new random node and edge orders from ``(seed, epoch)`` alone, so a run resumed from its
 checkpoint continues exactly as an uninterrupted one would (same orders, same optimizer state, same weights).
 The validation graphs are training rooms held back from fitting; the test rooms (the held-out split every
-evaluation compares with) play no part. Scoring a set (:func:`heldout_nll`) uses one fixed order per graph. The checkpoint (written atomically after every epoch) carries the
+evaluation compares with) play no part. Scoring a set (:func:`heldout_nll`) uses one fixed order per graph. The
+checkpoint (written atomically after every epoch) carries the
 config hash: a checkpoint of other settings is never resumed.
 """
 from __future__ import annotations
@@ -17,9 +18,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ....graphs.data import Graph, Vocab, sequence
 from ....learning import epochs
 from ....learning.device import pick_device  # noqa: F401 (re-exported for the stages)
-from ....graphs.data import Graph, Vocab, sequence
+from ....seeding import rng_for
 from .model import GraphModel
 from .teacher import KINDS, make_batch, nll
 
@@ -44,7 +46,7 @@ class Run:
 def heldout_nll(model: GraphModel, graphs: list[Graph], vocab: Vocab, seed: int, max_edges: int, batch_size: int,
                 device: str) -> np.ndarray:
     """``(len(graphs), 3)`` NLL per graph (validation or test) and decision kind, one fixed order per graph."""
-    rng = np.random.default_rng([seed, 77])
+    rng = rng_for(seed, "heldout-order")
     seqs = [sequence(g, rng, max_edges) for g in graphs]
     out = []
     with torch.no_grad():
@@ -60,7 +62,7 @@ def mean_nll(nll: np.ndarray) -> dict:
 
 def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) -> tuple[float, int]:
     """One pass over the training graphs in batches; returns the mean NLL per graph and edges dropped."""
-    rng = np.random.default_rng([seed, epoch])
+    rng = rng_for(seed, epoch)
     order = rng.permutation(len(graphs))
     seqs = [sequence(graphs[i], rng, max_edges) for i in order]
     total, dropped = 0.0, sum(s.dropped for s in seqs)

@@ -21,6 +21,7 @@ from ....graphs.data import DIRECTIONS, DISTANCES
 from ....placement.layout import View, box_frame, render, wall_frame, walls_of, with_objects
 from ....placement.proposers import nearest_wall
 from ....room import RoomInput, Walls
+from ....seeding import rng_for
 
 EDGE_KINDS = (*(f"{d}/{s}" for d in DIRECTIONS for s in DISTANCES), "support", "none")
 REACH = 4.0  # m: the scale of the target's position in its anchor's frame, as the orientation network reads it
@@ -161,7 +162,7 @@ FIELDS = ("loc", "cond", "cat", "row", "col", "ori", "rel", "bins", "snap")
 
 def batch(rooms: list[TrainingRoom], seed: int, step: int, size: int, loc_view: View, ori_view: View, cfg: dict):
     """``size`` examples drawn from ``(seed, step)`` as stacked arrays (``cfg``: bins, snap_angle (deg), none_share)."""
-    rng = np.random.default_rng([seed, step])
+    rng = rng_for(seed, step)
     out, tries = [], 0
     while len(out) < size and tries < 20 * size:
         tries += 1
