@@ -7,7 +7,7 @@ folds' test predictions, folded to ``max(a, 100 - a)`` (a classifier that is rel
 apart), with a bootstrap 95% interval over the test rooms. 50% is ideal.
 
 Two ways to train (``evaluate.sca.mode``): ``per_set``, a fresh classifier per set and fold (the protocol of issue 27);
-``shared`` (default, issue 41), one classifier per fold for all sets at once: a shared encoder with one logit per set,
+``shared`` (issue 41; opt-in, docs/departures.md), one classifier per fold for all sets at once: a shared encoder with one logit per set,
 each batch half real renders (a positive for every head) and half renders of the other sets (a negative for its own
 set's head only), so each head is a real-vs-that-set classifier on features every set helped learn. Each set keeps its
 own halves, its own test renders and its own score; the work is two trainings instead of two per set."""
