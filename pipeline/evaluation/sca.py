@@ -63,6 +63,11 @@ def fit_and_predict(real: torch.Tensor, other: torch.Tensor, test: torch.Tensor,
                           for b in test.split(256)]).cpu().numpy()
 
 
+def no_score() -> dict[str, float]:
+    """The score of a set the classifier cannot split into two folds (or with no real renders)."""
+    return {"accuracy": float("nan"), "low": float("nan"), "high": float("nan"), "train": 0, "test": 0}
+
+
 def halves(groups: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     """Index arrays of two halves of the items, split by group (``groups (m,)``: one id per item)."""
     ids = np.unique(groups)
@@ -99,7 +104,7 @@ def sca(real_train: np.ndarray, real_test: np.ndarray, other: np.ndarray, groups
     each fold then tests only the real rooms of its test half, never the originals of what it trained on. Images
     ``(n, s, s, 3)`` in [0, 1]."""
     if min(len(real_train), len(real_test)) < 1 or len(np.unique(groups)) < 2:
-        return {"accuracy": float("nan"), "low": float("nan"), "high": float("nan"), "train": 0, "test": 0}
+        return no_score()
     device = pick_device(cfg["device"])
     t = lambda a: torch.as_tensor(np.ascontiguousarray(np.asarray(a, np.float32).transpose(0, 3, 1, 2)), device=device)
     real_train_t, real_test_t, other_t = t(real_train), t(real_test), t(other)
@@ -179,8 +184,7 @@ def sca_shared(real_train: np.ndarray, real_test: np.ndarray, sets: dict[str, An
     names = [n for n, (_, groups, _) in sets.items() if len(np.unique(groups)) >= 2]
     if min(len(real_train), len(real_test)) < 1:
         names = []
-    out = {n: {"accuracy": float("nan"), "low": float("nan"), "high": float("nan"), "train": 0, "test": 0}
-           for n in sets if n not in names}
+    out = {n: no_score() for n in sets if n not in names}
     if not names:
         return out
     device = pick_device(cfg["device"])
