@@ -29,6 +29,7 @@ import torch
 
 from pipeline import config as config_mod, tables
 from pipeline.evaluation import functional as functional_checks, physical
+from pipeline.evaluation.distributions import category_kl
 from pipeline.evaluation.evaluate import off_axis_gap, off_axis_shares
 from pipeline.geometry.frames import turn_error
 from pipeline.learning import checkpoint
@@ -99,6 +100,16 @@ def evaluation_collisions(room, parent: dict, checker, ev: dict):
     return physical.colliding(room, [parent.get(i) for i in room.object_ids], checker.meshes_of(room), ev)
 
 
+def selection(corpus, plans: list, rooms: list) -> dict:
+    """Category KL to the held-out real rooms of the placed rooms and of every graph drawn for them: the difference
+    is what the search's failures select (graph_draws replaces a failed graph by the next)."""
+    real = [c for r in corpus.heldout() for c in r.categories]
+    drawn = [c for p in plans for c in p.categories]
+    placed = [c for r in rooms for c in r.categories]
+    return {"category_kl_placed": round(category_kl(real, placed), 4),
+            "category_kl_drawn": round(category_kl(real, drawn), 4)}
+
+
 def main() -> None:
     ap = arguments(__doc__)
     ap.add_argument("--room-type", default="bedroom")
@@ -162,6 +173,7 @@ def main() -> None:
               "failed_reasons": [r[8] for r in rows if not r[0]],
               "functional_placed": {k: round(float(v), 3) for k, v in
                                     pd.DataFrame(functional).mean().items()} if functional else None,
+              **selection(ctx.corpus, plans[:len(rows)], rooms),
               "off_axis_share": axis["all"], "off_axis_share_training": train_axis["all"],
               "off_axis_gap": off_axis_gap(axis, train_axis, cfg["evaluate"]["off_axis_min_objects"]),
               **(probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker) if args.location != "prior" else {}),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import re
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -35,7 +36,7 @@ free_floor: 1.0}
 """
 
 CFG = {"count_percentiles": [5, 95], "min_room_share": 0.1, "against_wall_share": 0.5, "support_share": 0.5,
-       "next_to_share": 0.3, "facing_share": 0.3, "stage_areas": [0.25, 1.0]}
+       "next_to_share": 0.3, "facing_share": 0.3, "stage_areas": [0.25, 1.0], "recipes": False}
 
 
 def _zero_lines(program: Program) -> Program:
@@ -307,3 +308,36 @@ def test_derivation_without_training_rooms_or_settings_fails():
     with pytest.raises(InputError, match="infinigen.derive: missing setting.*facing_share"):
         derive_program(nodes, edges, split, "bedroom", {k: v for k, v in CFG.items() if k != "facing_share"})
     assert STAGES == ("large", "medium", "small")
+
+
+def test_recipes_are_the_training_rooms_contents_drawn_as_wholes():
+    """With recipes, a scene's counts are one training room's: every lamp with its nightstand, the desk with its
+    chair; the recipes read back from the file, and each names its rooms."""
+    nodes, edges, split = _tables()
+    p, _ = derive_program(nodes, edges, split, "bedroom", {**CFG, "recipes": True})
+    assert sum(r.rooms for r in p.recipes) == 10 and p.recipes[0].rooms >= p.recipes[-1].rooms
+    for r in p.recipes:
+        assert r.counts["bed"] == 1 and r.counts.get("table_lamp", 0) == r.counts.get("nightstand", 0)
+        assert r.counts.get("desk", 0) == r.counts.get("chair", 0)
+    want = sorted((n, 1 if i < 5 else 0) for i, n in enumerate(NIGHTSTANDS))
+    got = sorted((r.counts.get("nightstand", 0), r.counts.get("desk", 0)) for r in p.recipes for _ in range(r.rooms))
+    assert got == want
+    text = dump_program(p, [])
+    assert "recipes:" in text and _zero_lines(parse_program(text)) == p
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        counts = p.counts(rng)
+        assert counts["nightstand"] == counts["table_lamp"] and counts["nightstand"][0] == counts["nightstand"][1]
+    seen = {p.counts(rng)["nightstand"][0] for _ in range(200)}
+    assert seen == set(NIGHTSTANDS)
+
+
+def test_a_program_without_recipes_draws_each_count_in_its_range_and_a_bad_recipe_names_its_line():
+    p = parse_program(EXAMPLE)
+    assert p.recipes == [] and p.counts(np.random.default_rng(0)) == {c: r.count for c, r in p.objects.items()}
+    first = next(iter(p.objects))
+    bad = EXAMPLE + f"recipes:\n  - {{rooms: 2, counts: {{{first}: 1}}}}\n  - {{rooms: 1, counts: {{piano: 1}}}}\n"
+    lines = bad.splitlines()
+    msg = _error(bad)
+    assert f"bedroom.yaml:{len(lines)}: recipes[1].counts.piano" in msg and "not an object of this program" in msg
+    assert _error(EXAMPLE + "recipes:\n  - {rooms: 0, counts: {}}\n").startswith(f"bedroom.yaml:{len(lines) - 1}")

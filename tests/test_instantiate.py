@@ -40,7 +40,8 @@ def catalog_room(categories, outline=((0, 0), (4, 0), (4, 3.5), (0, 3.5))):
 def setup(categories, outline=((0, 0), (4, 0), (4, 3.5), (0, 3.5)), **overrides):
     r = catalog_room(categories, outline)
     cfg = default_config()
-    ic = {**cfg["instantiate"], **overrides}
+    fixed = {"backtracks_per_object": 0} if "max_backtracks" in overrides else {}  # a test's budget is the one it names
+    ic = {**cfg["instantiate"], **fixed, **overrides}
     ext = {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
     checker = Checker(r.models, set(r.models), {}, ext, intersector_class("embree"), ic["checks"])
     empty = with_objects(r.room_input(), [])
@@ -133,6 +134,19 @@ def test_an_unsatisfiable_graph_ends_with_a_failure_record_not_a_hang():
     once = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker,
                        {**ic, "restarts": 0}, 0)
     assert once.attempts == 1 and once.backtracks == 6 and 0 < once.rejections < out.rejections
+
+
+def test_the_backtrack_budget_grows_with_the_objects_to_place():
+    """``backtracks_per_object``: a fixed budget fails large graphs more often than small ones (and graph_draws then
+    selects against them); a plan of two unsatisfiable beds gets 2 x 5 backtracks, one of them the floor of 6."""
+    room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=6, restarts=0, backtracks_per_object=5)
+    two = ScenePlan("s3", "r0", "bedroom", ["b", "c"], ["bed", "bed"], ["left-right"] * 2, [1, 1], [None, None],
+                    ["none", "none"], [PlanEdge("wall_0", "b", "spatial", "front", "adjacent")])
+    prior = Combined(RelationPrior(EXTRACT), FaceAway())
+    out = instantiate(two, room, walls, [0, 1], prior, pool, checker, ic, 0)
+    assert not out.ok and out.backtracks == 10 and "backtrack budget (10) spent" in out.reason
+    one = instantiate(_unsatisfiable(), room, walls, [0], prior, pool, checker, ic, 0)
+    assert one.backtracks == 6 and "backtrack budget (6) spent" in one.reason
 
 
 def test_a_scene_whose_first_search_spends_its_budget_is_placed_by_a_restart():

@@ -274,7 +274,7 @@ def test_an_unsatisfiable_plan_ends_with_its_cause_and_no_relaxed_object():
     plan = plan_of("n", "nightstand", [PlanEdge("bed", "n", "spatial", "left", "adjacent"),
                                        PlanEdge("bed", "n", "spatial", "right", "adjacent"),
                                        PlanEdge("bed", "n", "spatial", "front", "adjacent")])
-    ic = {**cfg["instantiate"], "max_backtracks": 10, "restarts": 0}
+    ic = {**cfg["instantiate"], "max_backtracks": 10, "backtracks_per_object": 0, "restarts": 0}
     out = instantiate(plan, room, walls, [0], Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway()), pool,
                       checker, ic, 0)
     assert not out.ok and "no place for n (nightstand)" in out.reason and "refused most by" in out.reason
@@ -296,3 +296,34 @@ def test_an_object_kept_with_a_broken_relation_is_recorded_with_the_edge_and_why
     assert rec["id"] == "n" and rec["failures"] >= cfg["instantiate"]["relax"]["start"] and rec["cost"] == pytest.approx(1 / 6, abs=1e-3)
     assert [(b["source"], b["planned"], b["found"]) for b in rec["broken"]] == [(walls.ids[0], "front/adjacent", "front/distant")]
     assert rec["cause"] == "violates"
+
+
+def test_the_off_axis_share_sees_a_set_turned_off_its_walls_and_not_a_set_turned_with_them():
+    """A known-bad set: the hand-built rooms with every object turned 30 degrees share 1.0 of off-axis objects per
+    category and sit 1.0 from the training rooms; the same rooms (walls turned by quarter turns with their
+    objects) share 0.0. A 3 degree turn stays under the 5 degree threshold."""
+    from dataclasses import replace as swap
+
+    from pipeline.evaluation.evaluate import off_axis_gap, off_axis_shares
+
+    rooms = [furnished(s).room_input() for s in range(12)]
+    turned = lambda deg: [swap(r, boxes=r.boxes + np.r_[np.zeros(6), np.radians(deg)]) for r in rooms]
+    train = off_axis_shares(rooms, None, 5.0)
+    assert train["all"] == 0.0 and set(train["categories"]) == set(SIZES)
+    bad = off_axis_shares(turned(30), None, 5.0)
+    assert bad["all"] == 1.0 and all(v == 1.0 for v in bad["categories"].values())
+    assert off_axis_gap(bad, train, 10) == 1.0 and off_axis_gap(train, train, 10) == 0.0
+    assert off_axis_shares(turned(3), None, 5.0)["all"] == 0.0
+    assert off_axis_gap(bad, train, 25) is None  # no category holds 25 objects in both sets (nightstands: 24)
+
+
+def test_the_relaxed_share_counts_the_objects_kept_with_a_broken_relation():
+    import pandas as pd
+
+    from pipeline.methods.scenes import relaxed, relaxed_share
+
+    rec = '[{"id": "a", "category": "sofa", "cause": "violates"}, {"id": "b", "category": "tv", "cause": "collides"}]'
+    scenes = pd.DataFrame({"relaxed_objects": [2, 0, None], "placed_objects": [10, 10, 0], "relaxed": [rec, "[]", None]})
+    assert relaxed_share(scenes) == 0.1
+    assert relaxed(scenes["relaxed"]) == {"sofa": {"violates": 1}, "tv": {"collides": 1}}
+    assert relaxed_share(scenes.assign(relaxed_objects=None)) is None  # a method that records none

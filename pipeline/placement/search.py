@@ -1,26 +1,26 @@
 """Placing a planned graph's objects one at a time with backtracking (PlanIT section 6, Appendix B).
 
-Each object asks the proposer for a pose (:class:`~pipeline.placement.proposers.Request`): a centre among the
-allowed candidates (the floor or its support's top, off what stands there, outside the squares around its rejected
-points) and a yaw, conditioned on its anchors (every planned edge to what is already placed); it slides flush against
-the anchors it must be adjacent to, then must pass :func:`~pipeline.placement.checks.check`. After its sample budget,
-the search backtracks to the nearest earlier object that caused one of its failures (or the one before it) and that
-object is placed afresh elsewhere. The relation tolerance is 0 until an object has failed ``relax.start`` times
-(``per_object``; PlanIT: until the scene has spent a quarter of its backtracks), then grows as
-``((f - start) / (full - start)) ** 1.5`` up to ``relax.max``; an object accepted with a broken relation is recorded with the edges it
-broke and why (:attr:`Outcome.relaxed`). A rejected point's square is sized to the object (``per_object``: a share of
-its smaller half extent, growing with its failures; PlanIT: 0.6 m growing with the scene's backtracks). With
-``keep_relations``, a candidate that breaks some of its relations within that tolerance is kept only when the
-object's remaining samples find none that keeps them all (the cheapest such candidate is taken). With
-``early_backtrack``, an object at zero tolerance whose planned bands share no free cell backtracks at once instead of
-spending its samples. A scene fails, with its reason, when the backtrack or candidate budget runs out (or the time
-budget, a safety net: the one outcome a machine's speed can change), or an object's category has no training
-instance; with ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the
-search goes on. A scene whose backtrack budget runs out starts over from scratch with a fresh seed, at most
-``restarts`` times (each attempt with its own budgets); its counts add up over the attempts. With ``redraw``, an
-object that spends its samples draws another training instance of its category (shared with its hub's spokes or
-its chain's members from then on): models are drawn at random, not by a predicted size, and a size that cannot fit
-is not forced on the object again.
+Each object asks the proposer for a pose (:class:`~pipeline.placement.proposers.Request`): a centre among the allowed
+candidates (the floor or its support's top, off what stands there, outside the squares around its rejected points) and a
+yaw, conditioned on its anchors (every planned edge to what is already placed); it slides flush against the anchors it
+must be adjacent to, then must pass :func:`~pipeline.placement.checks.check`. After its sample budget, the search
+backtracks to the nearest earlier object that caused one of its failures (or the one before it) and that object is
+placed afresh elsewhere, within a backtrack budget of ``backtracks_per_object`` per object to place (at least
+``max_backtracks``; PlanIT: a fixed 25, which fails large graphs far more often than small ones). The relation tolerance
+is 0 until an object has failed ``relax.start`` times (``per_object``; PlanIT: until the scene has spent a quarter of
+its backtracks), then grows as ``((f - start) / (full - start)) ** 1.5`` up to ``relax.max``; an object accepted with a
+broken relation is recorded with the edges it broke and why (:attr:`Outcome.relaxed`). A rejected point's square is
+sized to the object (``per_object``: a share of its smaller half extent, growing with its failures; PlanIT: 0.6 m
+growing with the scene's backtracks). With ``keep_relations``, a candidate that breaks some of its relations within that
+tolerance is kept only when the object's remaining samples find none that keeps them all (the cheapest such candidate is
+taken). With ``early_backtrack``, an object at zero tolerance whose planned bands share no free cell backtracks at once
+instead of spending its samples. A scene fails, with its reason, when the backtrack or candidate budget runs out (or the
+time budget, a safety net: the one outcome a machine's speed can change), or an object's category has no training
+instance; with ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search
+goes on. A scene whose backtrack budget runs out starts over from scratch with a fresh seed, at most ``restarts`` times
+(each attempt with its own budgets); its counts add up over the attempts. With ``redraw``, an object that spends its
+samples draws another training instance of its category (shared with its hub's spokes or its chain's members from then
+on): models are drawn at random, not by a predicted size, and a size that cannot fit is not forced on the object again.
 """
 from __future__ import annotations
 
@@ -165,6 +165,7 @@ class Search:
         self.accepted: dict = {}  # PlanEdge -> cost when its later end was last placed
         self.relaxed: dict[str, dict] = {}  # plan id -> its broken relations and why, as last placed
         self.exhausted = False  # the backtrack budget ran out (the one failure a restart may cure)
+        self.budget = max(cfg["max_backtracks"], int(np.ceil(cfg["backtracks_per_object"] * len(order))))
         self._free = None  # the last free_floor: (room boxes and grow, cells)
 
     def model_key(self, k: int) -> tuple:
@@ -238,8 +239,7 @@ class Search:
         if self.cfg["per_object"]:
             relax = self.cfg["relax"]
             return min(relax["max"], tolerance(self.strikes[v], relax["start"], relax["full"]))
-        budget = self.cfg["max_backtracks"]
-        return tolerance(self.backtracks, budget / 4, budget)
+        return tolerance(self.backtracks, self.budget / 4, self.budget)
 
     def reject_half(self, v: str, half) -> float:
         """Half side (m) of the square a rejected point of object ``v`` (half extents ``half (2,)``) clears: a share
@@ -386,7 +386,7 @@ class Search:
                 self.shared.pop(self.model_key(k), None)
             if self.candidates >= self.cfg["candidate_budget"]:
                 return f"candidate budget ({self.cfg['candidate_budget']}) spent at object {i + 1} of {len(self.order)}"
-            if self.backtracks >= self.cfg["max_backtracks"]:
+            if self.backtracks >= self.budget:
                 if self.cfg["on_exhausted"] == "drop":
                     self.drop(k, "no_place")
                     i += 1
@@ -402,7 +402,7 @@ class Search:
         v = self.plan.ids[k]
         refused = self.refusals.get(v)
         why = f"; refused most by {refused.most_common(1)[0][0]}" if refused else ""
-        return f"backtrack budget ({self.cfg['max_backtracks']}) spent: no place for {v} ({self.plan.categories[k]}){why}"
+        return f"backtrack budget ({self.budget}) spent: no place for {v} ({self.plan.categories[k]}){why}"
 
     def unit_start(self, i: int, j: int) -> int:
         """Where object ``order[i]``'s failure backtracks to when it blames ``order[j]``: the first member of their

@@ -24,10 +24,10 @@ import numpy as np
 import pandas as pd
 
 from ...errors import InputError
-from .program import DEFAULT_WEIGHTS, STAGES, ObjectRule, Program, dump_program
+from .program import DEFAULT_WEIGHTS, STAGES, ObjectRule, Program, Recipe, dump_program
 
 CFG_KEYS = ("count_percentiles", "min_room_share", "against_wall_share", "support_share", "next_to_share",
-            "facing_share", "stage_areas")
+            "facing_share", "stage_areas", "recipes")
 TRAINING = ("fit", "validation")
 Key = tuple[str, str]  # (room_id, node_id): one object instance
 
@@ -178,6 +178,15 @@ def _choice(category: str | None, share: float) -> dict:
     return {"category": category, "share": round(share, 3), "kept": False}
 
 
+def recipes_of(objects: pd.DataFrame, rooms: list[str], members: list[str]) -> list[Recipe]:
+    """The training rooms' contents over the program's categories, each distinct count vector once with the rooms
+    that held it (most rooms first, then by counts)."""
+    counts = pd.crosstab(objects["room_id"], objects["category"]).reindex(index=rooms, columns=members, fill_value=0)
+    tally = Counter(tuple(int(n) for n in row) for row in counts.to_numpy())
+    ranked = sorted(tally.items(), key=lambda kv: (-kv[1], [-n for n in kv[0]]))
+    return [Recipe(n, {c: k for c, k in zip(members, vec) if k > 0}) for vec, n in ranked]
+
+
 # ---------------------------------------------------------------- choices
 
 def _decide_support(why: dict[str, dict], members: list[str], threshold: float) -> dict[str, str]:
@@ -250,7 +259,7 @@ def derive_program(nodes: pd.DataFrame, edges: pd.DataFrame, split: dict[str, st
         w["in_program"] = cat in members
     rules = _rules(why, members, cfg)
     program = Program(room_type=room_type, objects={r.category: r for r in rules}, weights=dict(DEFAULT_WEIGHTS),
-                      source=f"derived:{room_type}")
+                      source=f"derived:{room_type}", recipes=recipes_of(objects, rooms, members) if cfg["recipes"] else [])
     return program, why
 
 
@@ -265,7 +274,8 @@ def program_header(room_type: str, n_rooms: int, cfg: dict) -> list[str]:
          f"room share >= {cfg['min_room_share']}; instance shares >= {shares}; "
          f"stage by median footprint, m^2 {list(cfg['stage_areas'])}."),
         ("Fields: count [min, max] per room; stage large | medium | small; against_wall; on / next_to / facing "
-         "name a category of this program; weights of the soft terms."),
+         "name a category of this program; weights of the soft terms; recipes: the training rooms' contents as "
+         "wholes (a scene draws one, in proportion to its rooms; without recipes each count is drawn in its range)."),
         "Edit and pass back with: planit generate --method infinigen --program FILE",
     ]
 

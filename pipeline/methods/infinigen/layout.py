@@ -4,6 +4,7 @@ annealer in each held-out room's architecture."""
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 from typing import Iterator
 
 import numpy as np
@@ -46,8 +47,10 @@ class InfinigenLayout:
                       "steps": self.cfg["presets"][self.cfg["preset"]]}
 
         def solve_one(state, hard, rng: np.random.Generator):
+            counts = program.counts(rng)  # a recipe's contents as a whole, or each rule's range
+            scene = {c: replace(s, count=counts[c]) for c, s in specs.items()}
             energy = Energy(hard, terms_of(program, self.cfg["reach"], walk))
-            proposer = Proposer(specs, ctx.pool, steps_of(self.cfg), violations=hard.total, attempts=self.cfg["attempts"])
-            return solve(state, specs, energy, proposer, solver_cfg, rng)
+            proposer = Proposer(scene, ctx.pool, steps_of(self.cfg), violations=hard.total, attempts=self.cfg["attempts"])
+            return solve(state, scene, energy, proposer, solver_cfg, rng)
 
         yield from solve_rooms(self.config, task, self.name, task.count or self.cfg["scenes"], solve_one)

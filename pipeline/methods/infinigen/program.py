@@ -1,6 +1,9 @@
 """Infinigen-style room programs (Raistrick et al. 2024): the small YAML file that says, per room type, which
 categories a room holds, how many of each, in which stage the annealing solver places them (large, medium, small:
-the paper's Alg. 1) and the hard and soft relations each one keeps, plus the weights of the solver's soft terms.
+the paper's Alg. 1) and the hard and soft relations each one keeps, plus the weights of the solver's soft terms,
+and (optional) the room's contents drawn as a whole: ``recipes``, each a count per category that training rooms
+held together (a bed with its two nightstands), drawn in proportion to its ``rooms``; a program without recipes
+draws each category's count within its range.
 
 This module holds the data classes (:class:`ObjectRule`, :class:`Program`), the format as a JSON Schema
 (:data:`SCHEMA`), the parser with line-numbered :class:`~pipeline.errors.InputError` messages
@@ -43,12 +46,31 @@ class ObjectRule:
 
 
 @dataclass(frozen=True)
+class Recipe:
+    """One room's contents as a whole: how many training rooms held exactly these counts (categories of the program
+    absent from ``counts`` hold 0)."""
+    rooms: int
+    counts: dict[str, int]   # category -> instances, categories of the program only
+
+
+@dataclass(frozen=True)
 class Program:
-    """A room type's program: its object rules in file order and the soft terms' weights (every term present)."""
+    """A room type's program: its object rules in file order, the soft terms' weights (every term present) and the
+    recipes its contents are drawn from (empty: each count drawn within its rule's range)."""
     room_type: str
     objects: dict[str, ObjectRule]   # category -> rule, in file order
     weights: dict[str, float]        # soft term -> weight, every key of TERMS present
     source: str = field(default="<program>", compare=False)
+    recipes: list[Recipe] = field(default_factory=list)
+
+    def counts(self, rng) -> dict[str, tuple[int, int]]:
+        """Category -> the (min, max) count of one scene: a recipe's exact counts drawn in proportion to its rooms,
+        or each rule's range when the program has no recipe."""
+        if not self.recipes:
+            return {c: r.count for c, r in self.objects.items()}
+        weight = [r.rooms for r in self.recipes]
+        recipe = self.recipes[int(rng.choice(len(weight), p=[w / sum(weight) for w in weight]))]
+        return {c: (recipe.counts.get(c, 0),) * 2 for c in self.objects}
 
 
 # ---------------------------------------------------------------- parsing
@@ -74,6 +96,10 @@ SCHEMA: dict[str, Any] = {  # the format; what a schema cannot say (names, cycle
                                      "minItems": 2, "maxItems": 2},
                            "stage": {"enum": list(STAGES)}, "against_wall": {"type": "boolean"},
                            **{rel: _NAME for rel in RELATIONS}}}},
+        "recipes": {"type": "array", "items": {
+            "type": "object", "required": ["rooms", "counts"], "additionalProperties": False,
+            "properties": {"rooms": {"type": "integer", "minimum": 1},
+                           "counts": {"type": "object", "additionalProperties": {"type": "integer", "minimum": 0}}}}},
         "weights": {"type": "object", "additionalProperties": False,
                     "properties": {t: {"type": "number", "minimum": 0, "format": "finite"} for t in TERMS}},
     },
@@ -126,6 +152,18 @@ def _check_cycles(objects: dict[str, ObjectRule], root: Node, source: str) -> No
         raise schemas.fail(*_where(root, source, cat, "on"), "support cycle: " + " on ".join([*loop, cat]))
 
 
+def _recipes(data: list[dict], objects: dict[str, ObjectRule], root: Node, source: str) -> list[Recipe]:
+    """The recipes, each naming categories of the program only."""
+    out = []
+    for i, entry in enumerate(data):
+        for cat in entry["counts"]:
+            if cat not in objects:
+                line = schemas.line_of(root, ("recipes", i, "counts", cat))
+                raise schemas.fail(source, line, f"recipes[{i}].counts.{cat}", f"'{cat}' is not an object of this program")
+        out.append(Recipe(int(entry["rooms"]), {c: int(n) for c, n in entry["counts"].items() if int(n) > 0}))
+    return out
+
+
 def parse_program(text: str, source: str = "<program>") -> Program:
     """A program from YAML text; every error is an InputError ``<source>:<line>: <field>: <what>``."""
     root = schemas.compose(text, source, _Loader)
@@ -139,7 +177,8 @@ def parse_program(text: str, source: str = "<program>") -> Program:
     _check_cycles(objects, root, source)
     _check_stages(objects, root, source)
     weights = {**DEFAULT_WEIGHTS, **{t: float(w) for t, w in data.get("weights", {}).items()}}
-    return Program(room_type=data["room_type"], objects=objects, weights=weights, source=source)
+    recipes = _recipes(data.get("recipes", []), objects, root, source)
+    return Program(room_type=data["room_type"], objects=objects, weights=weights, source=source, recipes=recipes)
 
 
 def load_program(path: Path) -> Program:
@@ -193,4 +232,8 @@ def dump_program(program: Program, header: list[str]) -> str:
     weights = {**DEFAULT_WEIGHTS, **program.weights}
     terms = [t for t in TERMS if t in weights] + [t for t in weights if t not in TERMS]
     lines.append("weights: {" + ", ".join(f"{t}: {_number(weights[t])}" for t in terms) + "}")
+    if program.recipes:
+        lines.append("recipes:  # a scene's contents: one recipe, drawn in proportion to its rooms (delete to draw by count)")
+        lines += ["  - {rooms: %d, counts: {%s}}" % (r.rooms, ", ".join(f"{_name(c)}: {n}" for c, n in r.counts.items()))
+                  for r in program.recipes]
     return "\n".join(lines) + "\n"
