@@ -59,3 +59,25 @@ def test_a_tree_furnishes_the_room_it_decodes_the_source_room_moved_to_the_origi
         mine = sorted(map(tuple, np.round(room.boxes[[c == cat for c in room.categories]][:, :3] - [2, 1.5, 0], 6)))
         theirs = sorted(map(tuple, np.round(got.boxes[[c == cat for c in got.categories]][:, :3], 6)))
         assert np.allclose(mine, theirs, atol=1e-5), cat
+
+
+def test_within_retrieval_never_takes_a_model_wider_than_the_decoded_box():
+    """Three beds (half widths 0.7, 0.8, 1.0 m): for a decoded box of half extents (0.82, 1.0) GRAINS's nearest
+    retrieval takes the 0.8 one; for (0.95, 1.0) the 1.0 one (reaching past the box), ``within`` the 0.8 one; for a
+    box narrower than every bed, ``within`` takes the smallest."""
+    from pipeline.placement.retrieval import nearest, nearest_within
+
+    rows = [{"category": "bed", "model_id": f"b{w}", "cx": 0.0, "cy": 0.0, "cz": 0.3, "hx": w, "hy": 1.0, "hz": 0.3,
+             "yaw": 0.0, "px": 0.0, "py": 0.0, "pz": 0.0, "sx": 1.0, "sy": 1.0, "sz": 1.0} for w in (0.7, 0.8, 1.0)]
+    pool = ModelPool(pd.DataFrame(rows), {})
+    assert nearest(pool, "bed", np.array([0.82, 1.0, 0.3])).model_id == "b0.8"
+    assert nearest(pool, "bed", np.array([0.95, 1.0, 0.3])).model_id == "b1.0"
+    assert nearest_within(pool, "bed", np.array([0.95, 1.0, 0.3])).model_id == "b0.8"
+    assert nearest_within(pool, "bed", np.array([0.5, 0.9, 0.3])).model_id == "b0.7"
+    assert nearest_within(pool, "sofa", np.array([0.5, 0.9, 0.3])) is None
+
+
+def test_within_retrieval_furnishes_the_source_room_back():
+    room, parents = bedroom()
+    got, _ = furnish(build_tree(room, parents), room, pool_of(room), "s", retrieval="within")
+    assert sorted(got.model_ids) == sorted(room.model_ids)

@@ -260,3 +260,37 @@ def test_a_grammar_names_its_errors_and_its_parse_trees_respect_support():
             load_grammar(path, "bedroom")
         with pytest.raises(InputError, match="room_type: 'bedroom', the task's is 'office'"):
             load_grammar(path, "office")
+
+
+def test_a_child_listed_before_its_parent_is_placed_on_it():
+    """S-AOG solves every category in one stage, in the grammar's order: ``tv`` sorts before ``tv_stand``, and a
+    child added before any parent has nowhere to stand (no television was ever placed). Parents come first."""
+    from pipeline.methods.solver.anneal import parents_first, start_stage
+
+    specs = {"tv": Spec("tv", (1, 1), "all", "on", "tv_stand"), "tv_stand": Spec("tv_stand", (1, 1), "all", "floor"),
+             "plant": Spec("plant", (1, 1), "all", "floor")}
+    assert [s.category for s in parents_first(list(specs.values()))] == ["tv_stand", "tv", "plant"]
+    r = room(4.0, 3.0)
+    p = pool({"tv": (0.4, 0.1, 0.3), "tv_stand": (0.6, 0.25, 0.25), "plant": (0.2, 0.2, 0.4)})
+    state = start_stage(empty_state(r, walls_of(r)), specs, "all", Proposer(specs, p, Steps(0.3, 0.1, 1.0, 0.0)),
+                        np.random.default_rng(0))
+    assert sorted(it.category for it in state.items) == ["plant", "tv", "tv_stand"]
+    tv = next(it for it in state.items if it.category == "tv")
+    assert state.items[tv.parent].category == "tv_stand"
+
+
+def test_the_solvers_overhang_limit_is_the_checkers_learned_one():
+    """A television 1.2 m wide on a 1.0 m stand keeps 83% of its footprint over it: an overhang at PlanIT's 0.9,
+    none where the training rooms taught the checker 0.7 for televisions (one function, placement.checks)."""
+    from pipeline.placement.checks import Checker
+
+    r = room(4.0, 3.0)
+    p = pool({"tv": (0.6, 0.1, 0.3), "tv_stand": (0.5, 0.25, 0.25)})
+    rng = np.random.default_rng(0)
+    state = empty_state(r, walls_of(r)).with_items([Item("s", "tv_stand", p.pick("tv_stand", "none", rng), "floor", "large", (2.0, 1.5)),
+                                                    Item("t", "tv", p.pick("tv", "none", rng), "on", "small", (0.0, 0.0), parent=0)])
+    assert Hard(state, LIMITS).counts(state)["overhang"] == 1
+    learned = Limits(0.01, 0.02, 0.0, 0.9, {"tv": 0.7})
+    assert Hard(state, learned).counts(state)["overhang"] == 0
+    checker = Checker({}, set(), {}, {}, None, {"min_support": 0.9}, support_floor={"tv": 0.7})
+    assert learned.support(["tv", "plant"]).tolist() == [checker.min_support("tv"), checker.min_support("plant")]

@@ -38,7 +38,7 @@ PROGRAM_LEARNERS = {p.name: p for p in [
     ProgramLearner("infinigen", "pipeline.methods.infinigen.derive:fit_program",
                    lambda config: ["seed", "infinigen.derive"]),
     ProgramLearner("saog", "pipeline.methods.saog.learn:fit_grammar",
-                   lambda config: ["seed", "saog", "instantiate.checks"]),
+                   lambda config: ["seed", "saog", "instantiate.checks", "floor_contact"]),
 ]}
 
 
@@ -87,7 +87,8 @@ BUILTIN = [
            description="the string VAE's sampled graphs placed the paper's way: each edge tagged with a relative-pose "
            "cluster by the edge tagger, assembled breadth-first from the walls with repair"),
     Method("grains", "pipeline.methods.grains.layout:GrainsLayout", model="grains",
-           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "grains.snap", *CONTEXT_KEYS],
+           keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "grains.snap", "grains.retrieval",
+                                      *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
            description="GRAINS: hierarchies decoded from a recursive VAE's prior, each wall group laid onto a held-out "
            "room's wall, models retrieved by size"),

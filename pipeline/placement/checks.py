@@ -37,6 +37,12 @@ def checks_config(config: dict) -> dict:
     return {**own, "confirm": None if own["penetration"] == evaluation else evaluation}
 
 
+def required_support(min_support: float, support_floor: dict[str, float], category: str) -> float:
+    """The share of its footprint an object of ``category`` must keep over its support: ``min_support`` (PlanIT's
+    0.9), lowered to the category's floor learned from the training rooms (:mod:`pipeline.placement.support`)."""
+    return min(min_support, support_floor.get(category, 1.0))
+
+
 @dataclass
 class Checker:
     """What the checks need besides the room: meshes (model id -> (vertices, faces)), box-only models, the model ->
@@ -52,7 +58,7 @@ class Checker:
 
     def min_support(self, category: str) -> float:
         """The share of its footprint an object of ``category`` must keep over its support."""
-        return min(self.cfg["min_support"], self.support_floor.get(category, 1.0))
+        return required_support(self.cfg["min_support"], self.support_floor, category)
 
     def meshes_of(self, room: RoomInput) -> list:
         """Each object's ``(vertices, faces)``, or None where it is measured as its box."""

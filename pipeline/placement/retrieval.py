@@ -65,6 +65,20 @@ def nearest(pool: ModelPool, category: str, half: np.ndarray) -> Instance | None
     return insts[int(np.argmin(np.linalg.norm(np.array([i.half for i in insts]) - half, axis=1)))]
 
 
+def nearest_within(pool: ModelPool, category: str, half: np.ndarray) -> Instance | None:
+    """The training instance of ``category`` nearest to ``half`` ``(3,)`` among those whose footprint half extents
+    fit inside ``half[:2]`` (a decoded box's model never reaches past the box); the smallest footprint when none
+    fits; None when the category has no instance."""
+    insts = pool.by_cat.get(category)
+    if not insts:
+        return None
+    h = np.array([i.half for i in insts])
+    fits = (h[:, :2] <= np.asarray(half)[:2] + 1e-9).all(1)
+    if not fits.any():
+        return insts[int(np.argmin(h[:, 0] * h[:, 1]))]
+    return insts[int(np.argmin(np.where(fits, np.linalg.norm(h - half, axis=1), np.inf)))]
+
+
 def place(inst: Instance, x: float, y: float, support: float | None, yaw: float) -> tuple[np.ndarray, np.ndarray]:
     """Box ``(7,)`` and pose ``(7,)`` (px, py, pz, yaw, sx, sy, sz) of the instance with its box centred on
     ``(x, y)``, turned to ``yaw``, its bottom on the ``support`` height (m), or for a floor object (None) at the

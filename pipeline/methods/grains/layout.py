@@ -15,7 +15,7 @@ import torch
 from ...learning import checkpoint
 from ...log import progress
 from ...placement.layout import add_object, walls_of, with_objects
-from ...placement.retrieval import ModelPool, nearest, place
+from ...placement.retrieval import ModelPool, nearest, nearest_within, place
 from ...room import RoomInput
 from ...seeding import seed_of
 from ..interface import Scene, Task
@@ -42,15 +42,17 @@ def supports(tree: Node) -> dict[int, int]:
     return {order[c]: order[p] for c, p in out.items() if c in order and p in order}
 
 
-def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False):
+def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False, retrieval: str = "nearest"):
     """The room (its architecture) with the tree's leaves laid onto its bounding rectangle, and each object's
     support parent id; leaves whose label has no training instance are left out. ``snap``: the codes' bits win
-    over their reals (:func:`.relpos.decode`)."""
+    over their reals (:func:`.relpos.decode`); ``retrieval``: ``nearest`` (GRAINS's) or ``within`` (the nearest
+    whose footprint fits the decoded one, :func:`~pipeline.placement.retrieval.nearest_within`)."""
     placed = layout(tree, room_rect(room), snap)
     on = supports(tree)
+    pick = nearest_within if retrieval == "within" else nearest
     out, ids, parents = with_objects(room, []), {}, {}
     for k, (label, _, box) in enumerate(placed):
-        inst = nearest(pool, label, box[3:6])
+        inst = pick(pool, label, box[3:6])
         if inst is None or (k in on and on[k] not in ids):
             continue
         top = None
@@ -67,10 +69,13 @@ class GrainsLayout:
     """``grains.scenes`` hierarchies decoded from the prior, laid onto the held-out rooms in turn."""
     rooms_info = "held-out rooms' bounding rectangles"
     own_architecture = False
+    faithful = False  # the faithful mode retrieves GRAINS's way (the nearest size), whatever grains.retrieval says
 
     def __init__(self, config: dict, name: str):
         self.config, self.name, self.cfg = config, name, config["grains"]
-        self.info = {"max_depth": self.cfg["max_depth"], "snap": self.cfg["snap"], "rooms": self.rooms_info}
+        self.retrieval = "nearest" if self.faithful else self.cfg["retrieval"]
+        self.info = {"max_depth": self.cfg["max_depth"], "snap": self.cfg["snap"], "rooms": self.rooms_info,
+                     "retrieval": self.retrieval}
 
     def room_for(self, tree: Node, k: int, scene_id: str, rooms: list[RoomInput]) -> RoomInput:
         """The architecture scene ``k`` is laid onto: the held-out ``rooms`` in turn."""
@@ -95,7 +100,7 @@ class GrainsLayout:
             start = time.perf_counter()
             sid = f"gen_{task.corpus.room_type}_{i:05d}"
             room = self.room_for(tree, i, sid, rooms)
-            placed, parents = furnish(tree, room, ctx.pool, sid, self.cfg["snap"])
+            placed, parents = furnish(tree, room, ctx.pool, sid, self.cfg["snap"], self.retrieval)
             record = {"seconds": decode_s + time.perf_counter() - start, "planned_objects": len(leaves(tree))}
             own = self.own_architecture
             yield Scene(sid, None if own else room.room_id, placed, walls_of(placed), record=record,
@@ -106,6 +111,7 @@ class GrainsDecoded(GrainsLayout):
     """GRAINS's faithful mode: each tree furnishes the room its own root and walls decode."""
     rooms_info = "the rooms the trees decode (own walls, no doors or windows)"
     own_architecture = True
+    faithful = True
 
     def room_for(self, tree: Node, k: int, scene_id: str, rooms: list[RoomInput]) -> RoomInput:
         """The room ``tree`` decodes, of the held-out rooms' type."""

@@ -53,4 +53,5 @@ class InfinigenLayout:
             proposer = Proposer(scene, ctx.pool, steps_of(self.cfg), violations=hard.total, attempts=self.cfg["attempts"])
             return solve(state, scene, energy, proposer, solver_cfg, rng)
 
-        yield from solve_rooms(self.config, task, self.name, task.count or self.cfg["scenes"], solve_one)
+        yield from solve_rooms(self.config, task, self.name, task.count or self.cfg["scenes"], solve_one,
+                               ctx.checker.support_floor)

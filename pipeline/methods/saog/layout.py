@@ -84,4 +84,5 @@ class SaogLayout:
         def solve_one(state, hard, rng: np.random.Generator):
             return sample_room(grammar, grammar["weights"], state, hard, ctx.pool, self.cfg, steps, rng)
 
-        yield from solve_rooms(self.config, task, self.name, task.count or self.cfg["scenes"], solve_one)
+        yield from solve_rooms(self.config, task, self.name, task.count or self.cfg["scenes"], solve_one,
+                               ctx.checker.support_floor)

@@ -13,6 +13,7 @@ import yaml
 from ...geometry.polygon import nearest_segment
 from ...placement.layout import walls_of
 from ...placement.retrieval import Instance, ModelPool
+from ...placement.support import learn_support_floor
 from ...room import BOX_COLUMNS, POSE_COLUMNS, RoomInput
 from ..solver.harness import limits_of
 from ..solver.state import Item, State, empty_state, wall_yaw
@@ -144,7 +145,7 @@ def learn_weights(grammar: dict, states: list[State], rooms: list[RoomInput], po
     cfg = config["saog"]
     preset = cfg["presets"][cfg["preset"]]
     data = np.array([per_object(features(s, grammar), s) for s in states])
-    limits = limits_of(config)
+    limits = limits_of(config, learn_support_floor(rooms, config["instantiate"]["checks"], config["floor_contact"]))
 
     def sample_features(w: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         weights = dict(zip(POTENTIALS, w))

@@ -61,12 +61,28 @@ def anneal(chain: Chain, energy: Energy, proposer: Proposer, active: set[str], s
     return chain
 
 
+def parents_first(specs: list[Spec]) -> list[Spec]:
+    """``specs`` in their order, except that each comes after its support parent's category (when listed)."""
+    by, out, seen = {s.category: s for s in specs}, [], set()
+
+    def visit(s: Spec, path: frozenset) -> None:
+        if s.category in seen or s.category in path:
+            return
+        if s.parent in by:
+            visit(by[s.parent], path | {s.category})
+        seen.add(s.category)
+        out.append(s)
+
+    for s in specs:
+        visit(s, frozenset())
+    return out
+
+
 def start_stage(state: State, specs: dict[str, Spec], stage: str, proposer: Proposer,
                 rng: np.random.Generator) -> State:
-    """The state with each of the stage's categories added up to its minimum count, at random places."""
-    for spec in specs.values():
-        if spec.stage != stage:
-            continue
+    """The state with each of the stage's categories added up to its minimum count, at random places; a support
+    parent's category before its children's (a child added before any parent has nowhere to stand)."""
+    for spec in parents_first([s for s in specs.values() if s.stage == stage]):
         for _ in range(max(spec.count[0] - state.count(spec.category), 0)):
             it = proposer.fresh(state, spec, rng)
             if it is not None:

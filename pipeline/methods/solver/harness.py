@@ -19,10 +19,12 @@ from .state import State, empty_state
 from .terms import Hard, Limits
 
 
-def limits_of(config: dict) -> Limits:
-    """The hard constraints' thresholds: PlanIT's placement checks' (``instantiate.checks``)."""
+def limits_of(config: dict, support_floor: dict[str, float] | None = None) -> Limits:
+    """The hard constraints' thresholds: PlanIT's placement checks' (``instantiate.checks``), with the support
+    shares its checker learned from the training rooms (``support_floor``: category -> share; televisions wider
+    than their stands)."""
     c = config["instantiate"]["checks"]
-    return Limits(c["collision"], c["outside"], c["door_clearance"], c["min_support"])
+    return Limits(c["collision"], c["outside"], c["door_clearance"], c["min_support"], dict(support_floor or {}))
 
 
 def steps_of(cfg: dict) -> Steps:
@@ -37,10 +39,12 @@ def majority_symmetry(pool: ModelPool, category: str) -> str:
 
 
 def solve_rooms(config: dict, task: Task, name: str, count: int,
-                solve_one: Callable[[State, Hard, np.random.Generator], Chain]) -> Iterator[Scene]:
-    """One scene per held-out room in turn, ``count`` in all: ``solve_one(empty state, hard, rng)`` anneals it."""
+                solve_one: Callable[[State, Hard, np.random.Generator], Chain],
+                support_floor: dict[str, float] | None = None) -> Iterator[Scene]:
+    """One scene per held-out room in turn, ``count`` in all: ``solve_one(empty state, hard, rng)`` anneals it
+    (``support_floor``: the checker's learned support shares, :func:`limits_of`)."""
     rooms = task.corpus.heldout()
-    limits = limits_of(config)
+    limits = limits_of(config, support_floor)
     for i in progress(range(count if rooms else 0), total=count, desc=f"{name} {task.corpus.room_type}"):
         room = rooms[i % len(rooms)]
         scene_id = f"gen_{task.corpus.room_type}_{i:05d}"

@@ -5,7 +5,7 @@ clearances (``placement.checks.blocks_door``'s zones) and overhangs (``placement
 are weighted scores (:class:`Term`); those of Infinigen's operators live in ``operators``."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -14,7 +14,7 @@ import shapely
 from ...geometry import boxes as gb
 from ...geometry.function import footprint_gaps
 from ...geometry.polygon import door_zones, outside_area
-from ...placement.checks import AREA_EPS, support_shares
+from ...placement.checks import AREA_EPS, required_support, support_shares
 from .state import State
 
 HARD = ("collision", "outside", "door", "overhang")
@@ -35,6 +35,12 @@ class Limits:
     outside: float  # m the footprint is eroded by before the outside test
     door: float  # m: depth of the clearance zone inside each door
     min_support: float  # share of a supported footprint that must rest on its parent
+    support_floor: dict[str, float] = field(default_factory=dict)  # category -> a lower share learned from training rooms
+
+    def support(self, categories: list[str]) -> np.ndarray:
+        """``(n,)`` the share each category must keep over its parent: PlanIT's check's
+        (:meth:`~pipeline.placement.checks.Checker.min_support`: ``min_support``, lowered by the learned floor)."""
+        return np.array([required_support(self.min_support, self.support_floor, c) for c in categories], float)
 
 
 def footprints(b: np.ndarray) -> np.ndarray:
@@ -90,7 +96,8 @@ class Hard:
                 door = shapely.area(shapely.intersection(shapely.polygons(corners), self.zones)) > AREA_EPS
         on = np.array([k for k, it in enumerate(state.items) if it.parent >= 0], int)
         parents = np.array([state.items[k].parent for k in on], int)
-        over: np.ndarray | list[bool] = support_shares(state.boxes[on], state.boxes[parents]) < self.limits.min_support if len(on) else []
+        need = self.limits.support([state.items[k].category for k in on])
+        over: np.ndarray | list[bool] = support_shares(state.boxes[on], state.boxes[parents]) < need if len(on) else []
         return {"collision": colliding_pairs(state, self.limits.collision)[:, 1].tolist(),
                 "outside": grounded[outside].tolist(), "door": grounded[door].tolist(),
                 "overhang": on[np.asarray(over, bool)].tolist()}
