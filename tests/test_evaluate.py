@@ -281,3 +281,27 @@ def test_cooccurrence_similarity_is_grains_conditional_measure():
     expected = 1 - np.mean(np.abs(p - cooccurrence(only_beds, ["bed", "desk", "nightstand"]))[~np.eye(3, dtype=bool)])
     assert cooccurrence_similarity(train, only_beds, 0.1) == pytest.approx(expected) and expected < 0.7
     assert np.isnan(cooccurrence_similarity(train, [], 0.1))
+
+
+def test_each_method_gets_one_sentence_from_its_figures():
+    """A method near the real rooms in category mix and collisions but failing the functional checks, and one
+    colliding everywhere: the sentences name each figure on its side, the classifier only with the power check."""
+    from pipeline.evaluation.pages import method_sentences
+
+    real = {"category_kl": 0.0, "object_collision_rate": 0.04, "out_of_bounds_rate": 0.0, "functional_all": 0.95}
+    sets = {"good": {"category_kl": 0.05, "object_collision_rate": 0.0, "out_of_bounds_rate": 0.0,
+                     "functional_all": 0.5, "sca": {"accuracy": 52.0}},
+            "bad": {"category_kl": 0.5, "object_collision_rate": 0.35, "out_of_bounds_rate": 0.02,
+                    "functional_all": 0.9, "sca": {"accuracy": 80.0}},
+            "real_heldout": real}
+    metrics = {"sets": sets, "floors": {"category_kl": {"mean": 0.05}}, "power": {"passed": True}}
+    got = method_sentences(metrics)["in one sentence"]
+    assert list(got.index) == ["good", "bad"]
+    assert got["good"].startswith("good at: category mix 1.0x the sampling floor; 0% of objects colliding (real 4%)")
+    assert "real-vs-synthetic classifier at 52%" in got["good"].split("Fails")[0]
+    assert got["good"].endswith("Fails at: 0.50 of rooms passing every functional check (real 0.95).")
+    assert "Fails at: category mix 10.0x the sampling floor; 35% of objects colliding (real 4%)" in got["bad"]
+    assert "0.90 of rooms passing every functional check" in got["bad"].split("Fails")[0]
+    assert "classifier at 80%" in got["bad"]
+    quiet = method_sentences({**metrics, "power": {"passed": False}})["in one sentence"]
+    assert "classifier" not in quiet["good"] + quiet["bad"]

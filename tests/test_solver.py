@@ -294,3 +294,28 @@ def test_the_solvers_overhang_limit_is_the_checkers_learned_one():
     assert Hard(state, learned).counts(state)["overhang"] == 0
     checker = Checker({}, set(), {}, {}, None, {"min_support": 0.9}, support_floor={"tv": 0.7})
     assert learned.support(["tv", "plant"]).tolist() == [checker.min_support("tv"), checker.min_support("plant")]
+
+
+def test_a_supported_categorys_set_node_is_learned_under_its_parent():
+    """Training rooms: 4 of 10 with a desk, each desk with a monitor. Learned over every room, the monitor's Set node
+    (0.4 of rooms) drawn independently of the desk's and zeroed without one gives 0.16 monitors per room; learned
+    over the rooms with a desk it is always 1, and the parse trees hold 0.4 monitors per room, each on a desk."""
+    from pipeline.methods.saog.learn import child_counts
+    from pipeline.methods.saog.sample import parse_tree
+    from pipeline.methods.saog.stats import learn_set
+
+    r = room(4.0, 3.0)
+    p = pool({"desk": (0.6, 0.3, 0.37), "monitor": (0.25, 0.08, 0.2)})
+    rng = np.random.default_rng(0)
+    states = []
+    for k in range(10):
+        items = [Item("d", "desk", p.pick("desk", "none", rng), "floor", "large", (2.0, 1.5)),
+                 Item("m", "monitor", p.pick("monitor", "none", rng), "on", "small", (0.0, 0.0), parent=0)] if k < 4 else []
+        states.append(empty_state(r, walls_of(r)).with_items(items))
+    assert child_counts(states, "monitor", "desk").tolist() == [1, 1, 1, 1]
+    assert child_counts(states, "desk", None).tolist() == [1] * 4 + [0] * 6
+    grammar = {"categories": {"desk": {"count": learn_set(child_counts(states, "desk", None))},
+                              "monitor": {"count": learn_set(child_counts(states, "monitor", "desk")), "on": "desk"}}}
+    trees = [parse_tree(grammar, np.random.default_rng(s)) for s in range(2000)]
+    assert all(t["monitor"] == t["desk"] for t in trees)
+    assert abs(np.mean([t["monitor"] for t in trees]) - 0.4) < 0.04

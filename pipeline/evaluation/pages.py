@@ -77,6 +77,49 @@ def check_rows(metrics: dict[str, Any]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["check", "every", "stands", "training rooms", "training share"]).set_index("check")
 
 
+# What each method is good at and where it fails, read from its figures against the real rooms': (figure, phrase,
+# good(value, real, floor), bad(value, real, floor)); a figure neither good nor bad is left out of the sentence.
+VERDICTS = (
+    ("category_kl", lambda v, r, f: f"category mix {v / f:.1f}x the sampling floor",
+     lambda v, r, f: v <= 1.5 * f, lambda v, r, f: v > 3 * f),
+    ("object_collision_rate", lambda v, r, f: f"{v:.0%} of objects colliding (real {r:.0%})",
+     lambda v, r, f: v <= r + 0.02, lambda v, r, f: v > r + 0.05),
+    ("out_of_bounds_rate", lambda v, r, f: f"{v:.0%} of objects out of bounds",
+     lambda v, r, f: v <= r + 0.01, lambda v, r, f: v > r + 0.05),
+    ("functional_all", lambda v, r, f: f"{v:.2f} of rooms passing every functional check (real {r:.2f})",
+     lambda v, r, f: v >= r - 0.10, lambda v, r, f: v < r - 0.15),
+    ("sca", lambda v, r, f: f"real-vs-synthetic classifier at {v:.0f}%",
+     lambda v, r, f: v <= 60, lambda v, r, f: v >= 70),
+)
+
+
+def method_sentences(metrics: dict[str, Any]) -> pd.DataFrame:
+    """One sentence per method from its measured figures: what lies near the real rooms (good at) and what lies far
+    from them (fails at), by :data:`VERDICTS`' thresholds; the classifier only where its power check passed."""
+    real = metrics["sets"][REAL]
+    floor = metrics.get("floors", {}).get("category_kl", {}).get("mean") or float("nan")
+    rows = []
+    for name, got in metrics["sets"].items():
+        if name == REAL:
+            continue
+        good, bad = [], []
+        for figure, phrase, is_good, is_bad in VERDICTS:
+            value = (got.get("sca") or {}).get("accuracy") if figure == "sca" else got.get(figure)
+            ref = real.get(figure) if figure != "sca" else 50.0
+            if value is None or value != value or ref is None or (figure == "sca" and not metrics["power"]["passed"]):
+                continue
+            if figure == "category_kl" and floor != floor:
+                continue
+            if is_good(value, ref, floor):
+                good.append(phrase(value, ref, floor))
+            elif is_bad(value, ref, floor):
+                bad.append(phrase(value, ref, floor))
+        text = (f"good at: {'; '.join(good)}" if good else "nothing near the real rooms") + \
+            (f". Fails at: {'; '.join(bad)}." if bad else ".")
+        rows.append({"set": name, "in one sentence": text})
+    return pd.DataFrame(rows, columns=["set", "in one sentence"]).set_index("set")
+
+
 def evaluation_page(metrics: dict[str, Any]) -> str:
     """The room type's evaluation page (HTML)."""
     first, real = list(metrics["sets"])[0], REAL
@@ -86,6 +129,10 @@ def evaluation_page(metrics: dict[str, Any]) -> str:
     mark_note = (f"value [95% bootstrap interval]; P: differs from {first}, R: differs from {real} (the interval "
                  "of the difference excludes 0)")
     return page(f"Evaluation: {metrics['room_type']}", [
+        Table("Every method in one sentence (from the figures below)", method_sentences(metrics),
+              "good at: within reach of the real rooms (category KL <= 1.5x its floor, collisions and out of bounds "
+              "within 2 and 1 points of real, functional_all within 10 points, SCA <= 60%); fails at: category KL > 3x "
+              "its floor, 5 points or more beyond real, functional_all more than 15 points under it, SCA >= 70%"),
         Table("Every method beside the real rooms", figures, mark_note, fmarks, FIGURES),
         Table("Functional checks (share of rooms holding both categories that pass)", checks,
               mark_note, cmarks),
