@@ -6,14 +6,15 @@ of the string VAE beside PlanIT's graph model's (the goal: within 1.2x on every 
 
     .venv/bin/python bench/strings_vae.py [--room-types bedroom ...] [--graphs 200] [--pairs 5]
 
-Reads results/graph_model/<type>/{planit,strings}/ and results/graphs/ingested/ of a pipeline run (the config's
-strings.sample settings otherwise).
+Run it in a pipeline run's folder: it reads results/graph_model/<type>/{planit,strings}/ and
+results/graphs/ingested/ (the config's strings.sample settings otherwise).
 """
 from __future__ import annotations
 
 import json
 import time
 from collections import Counter
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -24,9 +25,9 @@ from pipeline.methods.strings import rooms as R, sample as decoding
 from pipeline.methods.strings.fit import rooms_of
 from pipeline.methods.strings.train import room_strings
 
-from common import ROOT, arguments, report
+from common import arguments, report
 
-RUN = ROOT / "results"
+RUN = Path("results")  # the pipeline run in the current folder
 METRICS = ("node_count_tv", "category_kl", "edge_type_kl", "degree_mmd")
 
 

@@ -49,6 +49,14 @@ class SeqVAE(nn.Module):
         return logits, mu, logvar
 
 
+def kl_objective(mu: torch.Tensor, logvar: torch.Tensor, free_bits: float) -> torch.Tensor:
+    """The KL term a training step minimises, a scalar per string: each latent dimension's KL averaged over the
+    batch ``mu, logvar (B, latent)`` and held at ``free_bits`` nats at least (Kingma et al. 2016), summed over the
+    dimensions; 0: the plain KL's batch mean."""
+    per_dim = (-0.5 * (1 + logvar - mu.pow(2) - logvar.exp())).mean(0)
+    return torch.clamp(per_dim, min=free_bits).sum()
+
+
 def losses(logits: torch.Tensor, x: torch.Tensor, mu: torch.Tensor, logvar: torch.Tensor,
            forced: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
     """Per string ``(B,)``: the reconstruction NLL of ``x[:, 1:]`` (padding ignored; with ``forced (B,)`` the first

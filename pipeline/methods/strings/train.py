@@ -1,9 +1,10 @@
-"""Training the sequence VAE on room strings: each epoch draws new random depth-first strings of every fit room
-from ``(seed, epoch)`` alone (several per room, as the paper trains on several strings per shape), so a resumed
-run continues exactly as an uninterrupted one. Batched, Adam, word dropout (Bowman et al.), the KL weight annealed
-linearly from 0 to 1 over ``kl_anneal`` epochs; once annealed, training stops when the validation ELBO (fixed
-strings, full KL weight) has not improved for ``patience`` epochs; the epoch of the best validation ELBO is kept.
-The progress file (written atomically after every epoch) carries the config hash."""
+"""Training the sequence VAE on room strings: each epoch draws new random depth-first strings of every fit room from
+``(seed, epoch)`` alone (several per room, as the paper trains on several strings per shape), so a resumed run
+continues exactly as an uninterrupted one. Batched, Adam, word dropout (Bowman et al.), free bits per latent
+dimension (``free_bits``), the KL weight annealed linearly from 0 to 1 over ``kl_anneal`` epochs; once annealed,
+training stops when the validation ELBO (fixed strings, full KL weight) has not improved for ``patience`` epochs;
+the epoch of the best validation ELBO is kept. The progress file (written atomically after every epoch) carries the
+config hash."""
 from __future__ import annotations
 
 import logging
@@ -16,7 +17,7 @@ import torch
 
 from ...learning import epochs
 from ...seeding import rng_for
-from .model import SeqVAE, losses
+from .model import SeqVAE, kl_objective, losses
 from .serialize import StringGraph, arch_prefix, serialize_room, tokens
 from .vocab import UNK, TokenVocab
 
@@ -74,7 +75,7 @@ def _epoch(model, opt, strings: list[Text], vocab: TokenVocab, preset: dict, bet
         logits, mu, logvar = model(x, lengths, _word_dropout(x, vocab, preset["word_dropout"], gen), noise)
         nll, kl = losses(logits, x, mu, logvar, forced)
         opt.zero_grad()
-        (nll + beta * kl).mean().backward()
+        (nll.mean() + beta * kl_objective(mu, logvar, preset["free_bits"])).backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), preset["clip"])
         opt.step()
         nll_sum, kl_sum = nll_sum + float(nll.detach().sum()), kl_sum + float(kl.detach().sum())
