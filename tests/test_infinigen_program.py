@@ -329,7 +329,12 @@ def test_recipes_are_the_training_rooms_contents_drawn_as_wholes():
         counts = p.counts(rng)
         assert counts["nightstand"] == counts["table_lamp"] and counts["nightstand"][0] == counts["nightstand"][1]
     seen = {p.counts(rng)["nightstand"][0] for _ in range(200)}
-    assert seen == set(NIGHTSTANDS)
+    assert seen == set(NIGHTSTANDS) and p.objects["nightstand"].count == (0, 2)  # the whole range: no recipe cut
+    edited = dataclasses.replace(p, objects={**p.objects, "nightstand": dataclasses.replace(
+        p.objects["nightstand"], count=(1, 1)), "desk": dataclasses.replace(p.objects["desk"], count=(0, 0))})
+    for _ in range(50):  # a user's narrower range holds every recipe's count within it
+        counts = edited.counts(rng)
+        assert counts["nightstand"] == (1, 1) and counts["desk"] == (0, 0)
 
 
 def test_a_program_without_recipes_draws_each_count_in_its_range_and_a_bad_recipe_names_its_line():

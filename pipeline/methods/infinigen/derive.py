@@ -161,7 +161,7 @@ def _category_stats(objects: pd.DataFrame, links: pd.DataFrame, rooms: list[str]
     out = {}
     for category, group in objects.groupby("category", sort=True):
         keys = list(zip(group["room_id"], group["node_id"]))
-        count, raw = _count_range(counts[category], cfg["count_percentiles"])
+        count, raw = _count_range(counts[category], [0, 100] if cfg["recipes"] else cfg["count_percentiles"])
         out[category] = {
             "rooms_share": round(float((counts[category] > 0).mean()), 3), "instances": len(keys),
             "count_percentiles": raw, "count": list(count),
@@ -270,7 +270,8 @@ def program_header(room_type: str, n_rooms: int, cfg: dict) -> list[str]:
     return [
         (f"{room_type}: Infinigen-style program derived by pipeline.methods.infinigen.derive from the relation "
          f"graphs of {n_rooms} training rooms (fit + validation)."),
-        (f"Thresholds (infinigen.derive): count = percentiles {list(cfg['count_percentiles'])} of per-room counts; "
+        (f"Thresholds (infinigen.derive): count = percentiles "
+         f"{[0, 100] if cfg['recipes'] else list(cfg['count_percentiles'])} of per-room counts; "
          f"room share >= {cfg['min_room_share']}; instance shares >= {shares}; "
          f"stage by median footprint, m^2 {list(cfg['stage_areas'])}."),
         ("Fields: count [min, max] per room; stage large | medium | small; against_wall; on / next_to / facing "

@@ -65,12 +65,14 @@ class Program:
 
     def counts(self, rng) -> dict[str, tuple[int, int]]:
         """Category -> the (min, max) count of one scene: a recipe's exact counts drawn in proportion to its rooms,
-        or each rule's range when the program has no recipe."""
+        each held within its rule's range (a user who sets a count to [0, 0] gets none), or each rule's range when
+        the program has no recipe."""
         if not self.recipes:
             return {c: r.count for c, r in self.objects.items()}
         weight = [r.rooms for r in self.recipes]
         recipe = self.recipes[int(rng.choice(len(weight), p=[w / sum(weight) for w in weight]))]
-        return {c: (recipe.counts.get(c, 0),) * 2 for c in self.objects}
+        held = {c: min(max(recipe.counts.get(c, 0), r.count[0]), r.count[1]) for c, r in self.objects.items()}
+        return {c: (n, n) for c, n in held.items()}
 
 
 # ---------------------------------------------------------------- parsing
