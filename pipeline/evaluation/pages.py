@@ -129,11 +129,11 @@ def evaluation_page(metrics: dict[str, Any]) -> str:
     mark_note = (f"value [95% bootstrap interval]; P: differs from {first}, R: differs from {real} (the interval "
                  "of the difference excludes 0)")
     return page(f"Evaluation: {metrics['room_type']}", [
-        Table("Every method in one sentence (from the figures below)", method_sentences(metrics),
+        Table("Every method beside the real rooms", figures, mark_note, fmarks, FIGURES),
+        Table("Every method in one sentence (from the figures above)", method_sentences(metrics),
               "good at: within reach of the real rooms (category KL <= 1.5x its floor, collisions and out of bounds "
               "within 2 and 1 points of real, functional_all within 10 points, SCA <= 60%); fails at: category KL > 3x "
               "its floor, 5 points or more beyond real, functional_all more than 15 points under it, SCA >= 70%"),
-        Table("Every method beside the real rooms", figures, mark_note, fmarks, FIGURES),
         Table("Functional checks (share of rooms holding both categories that pass)", checks,
               mark_note, cmarks),
         Table("What the functional checks ask (learned from the training rooms)", check_rows(metrics)),
