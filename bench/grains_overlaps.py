@@ -32,6 +32,18 @@ from pipeline.seeding import seed_of
 from common import ROOT, arguments, report
 
 
+def retrieved(boxes: np.ndarray, placed: list, on: dict[int, int], pool, pick) -> np.ndarray:
+    """``(n, 7)`` the decoded ``boxes`` with each leaf's half extents those of the instance ``pick(pool, label, half)``
+    retrieves for it (a floor object's bottom kept on the floor)."""
+    got = boxes.copy()
+    for j, (label, _, box) in enumerate(placed):
+        inst = pick(pool, label, box[3:6])
+        if inst is not None:
+            got[j, 3:6] = inst.half
+            got[j, 2] = inst.half[2] if j not in on else got[j, 2]
+    return got
+
+
 def colliding_share(boxes: np.ndarray, on: dict[int, int], limit: float) -> tuple[int, int]:
     """(floor objects penetrating another floor object deeper than ``limit`` m, floor objects) of ``(n, 7)`` boxes;
     ``on``: supported object -> its support (left out)."""
@@ -72,20 +84,9 @@ def main() -> None:
                 tally[key] = [a + b for a, b in zip(tally[key], colliding_share(boxes, on, limit))]
                 if snap != cfg["grains"]["snap"]:
                     continue
-                got = boxes.copy()
-                for j, (label, _, box) in enumerate(placed):
-                    inst = nearest(ctx.pool, label, box[3:6])
-                    if inst is not None:
-                        got[j, 3:6] = inst.half
-                        got[j, 2] = inst.half[2] if j not in on else got[j, 2]
-                tally["retrieved"] = [a + c for a, c in zip(tally["retrieved"], colliding_share(got, on, limit))]
-                within = boxes.copy()
-                for j, (label, _, box) in enumerate(placed):
-                    inst = nearest_within(ctx.pool, label, box[3:6])
-                    if inst is not None:
-                        within[j, 3:6] = inst.half
-                        within[j, 2] = inst.half[2] if j not in on else within[j, 2]
-                tally["retrieved_within"] = [a + c for a, c in zip(tally["retrieved_within"], colliding_share(within, on, limit))]
+                for key, pick in (("retrieved", nearest), ("retrieved_within", nearest_within)):
+                    got = retrieved(boxes, placed, on, ctx.pool, pick)
+                    tally[key] = [a + c for a, c in zip(tally[key], colliding_share(got, on, limit))]
         report({"room_type": args.room_type, "rooms": mode, "scenes": len(trees), "collision_margin_m": limit,
                 "snap": cfg["grains"]["snap"],
                 **{f"{k}_colliding_share": round(v[0] / max(v[1], 1), 4) for k, v in tally.items()},
