@@ -20,6 +20,7 @@ import torch
 from torch import nn
 
 from ..learning.device import pick_device
+from ..log import progress
 from ..seeding import rng_for
 from .intervals import replicates
 
@@ -217,7 +218,8 @@ def sca_scores(real_maps: tuple[np.ndarray, np.ndarray], sets: dict[str, Any], c
     renders (groups None: one per image; real_groups None: the set is not made from the held-out rooms)."""
     torch.set_num_threads(max(threads, 1))
     return {name: sca(real_maps[0], real_maps[1], images, np.arange(len(images)) if groups is None else groups, cfg,
-                      seed, real_groups) for name, (images, groups, real_groups) in sets.items()}
+                      seed, real_groups)
+            for name, (images, groups, real_groups) in progress(sets.items(), len(sets), "SCA classifiers (per set)")}
 
 
 def sca_all(real_maps: tuple[np.ndarray, np.ndarray], sets: dict[str, Any], control: tuple[np.ndarray, np.ndarray, str],
