@@ -26,6 +26,7 @@ import torch
 import torch.nn.functional as fn
 from torch import Tensor, nn
 
+from ...learning.divergence import gaussian_kl
 from . import relpos
 from .hierarchy import KINDS, Node
 
@@ -252,7 +253,7 @@ class GrainsVAE(nn.Module):
             z = mu + torch.randn(mu.shape, generator=gen).to(mu.device) * torch.exp(0.5 * logvar)
         terms = self.reconstruct(f, z)
         out = {k: v.mean() for k, v in terms.items()}
-        out["kl"] = (-0.5 * (1 + logvar - mu ** 2 - logvar.exp()).sum(1)).mean()
+        out["kl"] = gaussian_kl(mu, logvar).sum(1).mean()
         out["total"] = out["recon"] + out["kind"] + out["label"] + kl_weight * out["kl"]
         return out
 

@@ -7,6 +7,8 @@ import torch
 from torch import nn
 from torch.nn.utils.rnn import pack_padded_sequence
 
+from ...learning.divergence import gaussian_kl
+
 
 class SeqVAE(nn.Module):
     def __init__(self, vocab_size: int, embed: int, hidden: int, latent: int, layers: int = 1):
@@ -53,8 +55,7 @@ def kl_objective(mu: torch.Tensor, logvar: torch.Tensor, free_bits: float) -> to
     """The KL term a training step minimises, a scalar per string: each latent dimension's KL averaged over the
     batch ``mu, logvar (B, latent)`` and held at ``free_bits`` nats at least (Kingma et al. 2016), summed over the
     dimensions; 0: the plain KL's batch mean."""
-    per_dim = (-0.5 * (1 + logvar - mu.pow(2) - logvar.exp())).mean(0)
-    return torch.clamp(per_dim, min=free_bits).sum()
+    return torch.clamp(gaussian_kl(mu, logvar).mean(0), min=free_bits).sum()
 
 
 def losses(logits: torch.Tensor, x: torch.Tensor, mu: torch.Tensor, logvar: torch.Tensor,
@@ -65,5 +66,4 @@ def losses(logits: torch.Tensor, x: torch.Tensor, mu: torch.Tensor, logvar: torc
     if forced is not None:
         target = target.masked_fill(torch.arange(target.shape[1], device=x.device)[None] < forced[:, None], 0)
     nll = nn.functional.cross_entropy(logits.transpose(1, 2), target, ignore_index=0, reduction="none").sum(1)
-    kl = -0.5 * (1 + logvar - mu.pow(2) - logvar.exp()).sum(1)
-    return nll, kl
+    return nll, gaussian_kl(mu, logvar).sum(1)
