@@ -153,15 +153,26 @@ def _stage(area: float, areas: list[float]) -> str:
     return STAGES[2] if area < areas[0] else STAGES[1] if area < areas[1] else STAGES[0]
 
 
-def _category_stats(objects: pd.DataFrame, links: pd.DataFrame, rooms: list[str], cfg: dict) -> dict[str, dict]:
-    """Category -> the statistics behind every choice, before the choices are reconciled across categories."""
-    counts = pd.crosstab(objects["room_id"], objects["category"]).reindex(rooms, fill_value=0)
+def room_counts(objects: pd.DataFrame, rooms: list[str]) -> pd.DataFrame:
+    """``(rooms, categories)`` instances of each category in each training room (0 where none)."""
+    return pd.crosstab(objects["room_id"], objects["category"]).reindex(rooms, fill_value=0)
+
+
+def count_percentiles(cfg: dict) -> list[float]:
+    """The percentiles of the per-room counts a count range spans: with recipes the whole range (0, 100), so that no
+    recipe is cut by its rules; else ``count_percentiles``."""
+    return [0, 100] if cfg["recipes"] else list(cfg["count_percentiles"])
+
+
+def _category_stats(objects: pd.DataFrame, links: pd.DataFrame, counts: pd.DataFrame, cfg: dict) -> dict[str, dict]:
+    """Category -> the statistics behind every choice, before the choices are reconciled across categories
+    (``counts``: :func:`room_counts`)."""
     walls, parents = _wall_targets(links), _support_parents(links)
     beside, front = _beside(objects, links), _in_front_of(links)
     out = {}
     for category, group in objects.groupby("category", sort=True):
         keys = list(zip(group["room_id"], group["node_id"]))
-        count, raw = _count_range(counts[category], [0, 100] if cfg["recipes"] else cfg["count_percentiles"])
+        count, raw = _count_range(counts[category], count_percentiles(cfg))
         out[category] = {
             "rooms_share": round(float((counts[category] > 0).mean()), 3), "instances": len(keys),
             "count_percentiles": raw, "count": list(count),
@@ -178,11 +189,10 @@ def _choice(category: str | None, share: float) -> dict:
     return {"category": category, "share": round(share, 3), "kept": False}
 
 
-def recipes_of(objects: pd.DataFrame, rooms: list[str], members: list[str]) -> list[Recipe]:
-    """The training rooms' contents over the program's categories, each distinct count vector once with the rooms
-    that held it (most rooms first, then by counts)."""
-    counts = pd.crosstab(objects["room_id"], objects["category"]).reindex(index=rooms, columns=members, fill_value=0)
-    tally = Counter(tuple(int(n) for n in row) for row in counts.to_numpy())
+def recipes_of(counts: pd.DataFrame, members: list[str]) -> list[Recipe]:
+    """The training rooms' contents over the program's categories (``counts``: :func:`room_counts`), each distinct
+    count vector once with the rooms that held it (most rooms first, then by counts)."""
+    tally = Counter(tuple(int(n) for n in row) for row in counts[members].to_numpy())
     ranked = sorted(tally.items(), key=lambda kv: (-kv[1], [-n for n in kv[0]]))
     return [Recipe(n, {c: k for c, k in zip(members, vec) if k > 0}) for vec, n in ranked]
 
@@ -250,7 +260,8 @@ def derive_program(nodes: pd.DataFrame, edges: pd.DataFrame, split: dict[str, st
     if not rooms:
         raise InputError(f"room type '{room_type}': no training (fit or validation) room to derive a program from")
     objects = _objects(nodes, rooms)
-    why = _category_stats(objects, _links(edges, nodes, rooms), rooms, cfg)
+    counts = room_counts(objects, rooms)
+    why = _category_stats(objects, _links(edges, nodes, rooms), counts, cfg)
     members = sorted(c for c, w in why.items() if w["rooms_share"] >= cfg["min_room_share"])
     if not members:
         raise InputError(f"room type '{room_type}': no category occurs in {cfg['min_room_share']} of the "
@@ -259,7 +270,7 @@ def derive_program(nodes: pd.DataFrame, edges: pd.DataFrame, split: dict[str, st
         w["in_program"] = cat in members
     rules = _rules(why, members, cfg)
     program = Program(room_type=room_type, objects={r.category: r for r in rules}, weights=dict(DEFAULT_WEIGHTS),
-                      source=f"derived:{room_type}", recipes=recipes_of(objects, rooms, members) if cfg["recipes"] else [])
+                      source=f"derived:{room_type}", recipes=recipes_of(counts, members) if cfg["recipes"] else [])
     return program, why
 
 
@@ -270,8 +281,7 @@ def program_header(room_type: str, n_rooms: int, cfg: dict) -> list[str]:
     return [
         (f"{room_type}: Infinigen-style program derived by pipeline.methods.infinigen.derive from the relation "
          f"graphs of {n_rooms} training rooms (fit + validation)."),
-        (f"Thresholds (infinigen.derive): count = percentiles "
-         f"{[0, 100] if cfg['recipes'] else list(cfg['count_percentiles'])} of per-room counts; "
+        (f"Thresholds (infinigen.derive): count = percentiles {count_percentiles(cfg)} of per-room counts; "
          f"room share >= {cfg['min_room_share']}; instance shares >= {shares}; "
          f"stage by median footprint, m^2 {list(cfg['stage_areas'])}."),
         ("Fields: count [min, max] per room; stage large | medium | small; against_wall; on / next_to / facing "
