@@ -40,7 +40,8 @@ def retrieved(boxes: np.ndarray, placed: list, on: dict[int, int], pool, pick) -
         inst = pick(pool, label, box[3:6])
         if inst is not None:
             got[j, 3:6] = inst.half
-            got[j, 2] = inst.half[2] if j not in on else got[j, 2]
+            if j not in on:
+                got[j, 2] = inst.half[2]
     return got
 
 
