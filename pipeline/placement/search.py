@@ -188,19 +188,21 @@ class Search:
             self.shared[key] = self.pool.pick(cat, self.plan.symmetry[k], self.rng, grounded)
         return self.shared[key]
 
-    def occupied(self, grow: float) -> np.ndarray:
-        """``(cells,)`` candidate centres inside a placed floor object's footprint grown by ``grow`` m."""
-        b = self.room.boxes.reshape(-1, 7)
+    def occupied(self, grow: float, room: RoomInput | None = None) -> np.ndarray:
+        """``(cells,)`` candidate centres inside a placed floor object's footprint grown by ``grow`` m (in ``room``,
+        else the search's room)."""
+        b = (room or self.room).boxes.reshape(-1, 7)
         floor = b[b[:, 2] - b[:, 5] < self.cfg["checks"]["collision"] + 0.05]
         return _in_box(self.grid.points, floor, (-grow, -grow)).any(0)
 
-    def free_floor(self, half) -> np.ndarray:
-        """``(cells,)`` candidate centres on the floor and off the placed floor objects grown by the smaller of an
-        object's half extents ``half (2,)`` (a fresh array; the last one is kept, as an object's samples ask again)."""
-        grow = float(min(half))
-        key = (self.room.boxes.tobytes(), grow)
+    def free_floor(self, half, room: RoomInput | None = None) -> np.ndarray:
+        """``(cells,)`` candidate centres on the floor and off the placed floor objects of ``room`` (else the search's
+        room) grown by the smaller of an object's half extents ``half (2,)`` (a fresh array; the last one is kept, as
+        an object's samples ask again)."""
+        room, grow = room or self.room, float(min(half))
+        key = (room.boxes.tobytes(), grow)
         if self._free is None or self._free[0] != key:
-            self._free = (key, self.grid.floor & ~self.occupied(grow))
+            self._free = (key, self.grid.floor & ~self.occupied(grow, room))
         return self._free[1].copy()
 
     def free_top(self, pk: int, half) -> np.ndarray:
@@ -217,10 +219,29 @@ class Search:
         on[pk] = False
         return top & ~_in_box(self.grid.points, b[on], (-grow, -grow)).any(0) if on.any() else top
 
-    def band_cells(self, anchors: list[Anchor], half) -> np.ndarray:
-        """``(cells,)`` :meth:`free_floor` cells inside every anchor's planned band
-        (:class:`~pipeline.placement.proposers.RelationPrior`, no softness)."""
-        return self.free_floor(half) & (self.bands.density(self.room, self.walls, "", anchors, self.grid.points) > 0)
+    def band_cells(self, anchors: list[Anchor], half, room: RoomInput | None = None) -> np.ndarray:
+        """``(cells,)`` :meth:`free_floor` cells of ``room`` (else the search's room) inside every anchor's planned
+        band (:class:`~pipeline.placement.proposers.RelationPrior`, no softness)."""
+        room = room or self.room
+        return self.free_floor(half, room) & (self.bands.density(room, self.walls, "", anchors, self.grid.points) > 0)
+
+    def forecloses(self, i: int, room: RoomInput, tol: float) -> set[str] | None:
+        """With ``lookahead`` (forward checking), at zero tolerance: when object ``order[i]`` placed as in ``room``
+        leaves a later floor object it has a planned spatial edge with no free cell in every band of its placed
+        anchors (two at least), those other anchors (what to move instead); else None."""
+        if not self.cfg["lookahead"] or tol > 0:
+            return None
+        v = self.plan.ids[self.order[i]]
+        for j in self.order[i + 1:]:
+            w = self.plan.ids[j]
+            if self.plan.parent[j] is not None or not any(
+                    e.edge_type == "spatial" and {e.source, e.target} == {v, w} for e in self.plan.edges):
+                continue
+            half = self.model_for(j).half[:2]
+            anchors = anchors_of(w, self.plan, room, self.walls, self.sym, half)
+            if len(anchors) >= 2 and not self.band_cells(anchors, half, room).any():
+                return {a.node for a in anchors if a.obj is not None and a.node != v}
+        return None
 
     def nowhere(self, k: int, tol: float) -> set[str] | None:
         """With ``early_backtrack``, at zero tolerance: the placed objects among floor object ``k``'s anchors when
@@ -290,8 +311,9 @@ class Search:
         box, pose = place(inst, box[0], box[1], support, yaw)
         return xy, box, pose, inst.model_id, pk
 
-    def try_place(self, k: int) -> set[str] | None:
-        """Place object ``k`` within its sample budget: None on success, else the culprits of its failures."""
+    def try_place(self, i: int) -> set[str] | None:
+        """Place object ``order[i]`` within its sample budget: None on success, else the culprits of its failures."""
+        k = self.order[i]
         v = self.plan.ids[k]
         culprits: set[str] = set()
         budget = max(self.cfg["min_samples"], self.cfg["samples"] - self.backtracks // 5)
@@ -315,6 +337,10 @@ class Search:
             present = set(self.room.object_ids) | set(self.walls.ids)
             verdict = check(room, len(room.object_ids) - 1, None if pk is None else pk, set(),
                             planned_edges(v, self.plan, present), tol, self.checker)
+            foreclosed = self.forecloses(i, room, tol) if verdict.ok else None
+            if foreclosed is not None:
+                verdict = replace(verdict, ok=False, reason="forecloses a later object's planned place",
+                                  culprits=foreclosed)
             if verdict.ok and (verdict.cost == 0 or not self.cfg["keep_relations"]):
                 return self.accept(k, room, verdict, tol)
             if verdict.ok:
@@ -377,7 +403,7 @@ class Search:
                 self.drop(k, "no_model" if k in missing else "support_dropped")
                 i += 1
                 continue
-            culprits = self.try_place(k)
+            culprits = self.try_place(i)
             if culprits is None:
                 i += 1
                 continue
