@@ -47,10 +47,11 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, 
     ``intersector`` a trimesh ray class; ``box_models`` the ids of models that are only a box (the box-contact
     rules apply to those alone; None: every model); ``anchors``: the ids of the objects and walls whose sides are
     swept (None: all), so that only spatial edges from them are found, each exactly as the whole sweep finds it
-    (every side is swept on its own; what is not swept only occludes).
+    (every side is swept on its own; what is not swept only occludes), and the architecture's edges (walls to walls
+    and openings, which no object's relation reads) are left out.
     """
     g = RoomGraph()
-    walls = merge_walls(room.wall_segments, room.wall_ids, room.wall_thickness, room.height)
+    walls = _merged_walls(room)
     keep, parts = _usable_objects(g, room, mesh_of)
     ids = [room.object_ids[k] for k in keep]
     cats = [room.categories[k] for k in keep]
@@ -78,8 +79,24 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, 
     group[hanging] = n + 1 + np.flatnonzero(hanging)
     group = np.concatenate([group, np.zeros(n_walls, int)])
     g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg, anchors)
-    _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
+    if anchors is None:
+        _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
     return g
+
+
+_WALLS: dict[tuple, Walls] = {}  # a search extracts one room's walls once per candidate: merged once per room
+
+
+def _merged_walls(room: RoomInput) -> Walls:
+    """The room's merged walls (:func:`~pipeline.room.merge_walls`), kept for the last few rooms (keyed on content;
+    the same object is returned, and no caller changes it)."""
+    key = (np.asarray(room.wall_segments, float).tobytes(), tuple(room.wall_ids),
+           np.asarray(room.wall_thickness, float).tobytes(), float(room.height))
+    if key not in _WALLS:
+        if len(_WALLS) >= 8:
+            _WALLS.pop(next(iter(_WALLS)))
+        _WALLS[key] = merge_walls(room.wall_segments, room.wall_ids, room.wall_thickness, room.height)
+    return _WALLS[key]
 
 
 def _room_scene(parts: list, b: np.ndarray, walls: Walls, intersector) -> tuple[RoomScene, np.ndarray]:
