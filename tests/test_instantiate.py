@@ -108,7 +108,7 @@ def test_backtracking_recovers_from_a_planted_impossible_first_choice():
                                         PlanEdge("w", "d", "spatial", "right", "adjacent")])
     proposer = Combined(PlantedCorner(), FaceAway())
     out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), proposer, pool, checker,
-                      {**ic, "lookahead": False}, 0)
+                      {**ic, "lookahead": "none"}, 0)
     assert not proposer.location.first  # the planted corner was proposed
     assert out.ok and out.backtracks >= 1, (out.reason, out.backtracks)
     w = out.room.boxes[out.room.object_ids.index("w")]
@@ -118,7 +118,7 @@ def test_backtracking_recovers_from_a_planted_impossible_first_choice():
     # wardrobe against the wall): no backtrack at all
     proposer = Combined(PlantedCorner(), FaceAway())
     looked = instantiate(plan, room, walls, order.placement_order(plan, AREAS), proposer, pool, checker,
-                         {**ic, "lookahead": True}, 0)
+                         {**ic, "lookahead": "at_zero_tolerance"}, 0)
     assert not proposer.location.first and looked.ok and looked.backtracks == 0, (looked.reason, looked.failures)
     assert looked.failures.get("forecloses", 0) >= 1
     assert scene_metrics.consistency(plan, looked.room, walls.ids, checker)["consistency"] == 1.0
@@ -161,7 +161,7 @@ def test_the_backtrack_budget_grows_with_the_objects_to_place():
 def test_a_scene_whose_first_search_spends_its_budget_is_placed_by_a_restart():
     """PlantedCorner's one bad proposal sinks the first attempt when no backtrack is allowed (and no lookahead
     refuses it); the restart searches from scratch and places the scene with every planned edge."""
-    room, walls, pool, checker, ic = setup(["wardrobe", "desk"], max_backtracks=0, lookahead=False)
+    room, walls, pool, checker, ic = setup(["wardrobe", "desk"], max_backtracks=0, lookahead="none")
     plan = ScenePlan("s1", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1], [None, None],
                      ["none", "none"], [PlanEdge("wall_0", "w", "spatial", "front", "adjacent"),
                                         PlanEdge("wall_0", "d", "spatial", "front", "adjacent"),

@@ -340,7 +340,7 @@ def _desk_and_chair(walls) -> ScenePlan:
 def test_forward_checking_refuses_a_place_that_leaves_a_later_object_none():
     """Known answers of the lookahead: a desk facing the bottom wall a chair's depth from it leaves the chair cells in
     both of its bands; the same desk in the middle of the room leaves none (refused, nothing earlier to blame); at a
-    grown tolerance, or with ``lookahead`` off, nothing is refused."""
+    grown tolerance nothing is refused (``at_zero_tolerance``, the default) unless ``always``; with ``none``, never."""
     from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
     from pipeline.placement.search import Search
 
@@ -353,8 +353,10 @@ def test_forward_checking_refuses_a_place_that_leaves_a_later_object_none():
     assert search.forecloses(0, near, 0.0) is None
     assert search.forecloses(0, middle, 0.0) == set()
     assert search.forecloses(0, middle, 0.1) is None
-    off = Search(plan, room, walls, [0, 1], proposer, pool, checker, {**ic, "lookahead": False}, np.random.default_rng(0))
-    assert off.forecloses(0, middle, 0.0) is None
+    mode = lambda m: Search(plan, room, walls, [0, 1], proposer, pool, checker, {**ic, "lookahead": m},
+                            np.random.default_rng(0))
+    assert mode("none").forecloses(0, middle, 0.0) is None
+    assert mode("always").forecloses(0, middle, 0.1) == set() and mode("always").forecloses(0, near, 0.1) is None
 
 
 def test_with_forward_checking_the_chair_keeps_both_relations():
@@ -367,7 +369,7 @@ def test_with_forward_checking_the_chair_keeps_both_relations():
     plan, proposer = _desk_and_chair(walls), Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway())
     run = lambda look: [instantiate(plan, room, walls, [0, 1], proposer, pool, checker,
                                     {**cfg["instantiate"], "lookahead": look}, seed) for seed in range(20)]
-    with_look, without = run(True), run(False)
+    with_look, without = run("at_zero_tolerance"), run("none")
     assert all(o.ok for o in with_look + without)
     relaxed = lambda outs: sum(bool(o.relaxed) for o in outs)
     assert relaxed(with_look) <= 3 and relaxed(without) >= 8, (relaxed(with_look), relaxed(without))

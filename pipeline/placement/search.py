@@ -226,10 +226,11 @@ class Search:
         return self.free_floor(half, room) & (self.bands.density(room, self.walls, "", anchors, self.grid.points) > 0)
 
     def forecloses(self, i: int, room: RoomInput, tol: float) -> set[str] | None:
-        """With ``lookahead`` (forward checking), at zero tolerance: when object ``order[i]`` placed as in ``room``
-        leaves a later floor object it has a planned spatial edge with no free cell in every band of its placed
-        anchors (two at least), those other anchors (what to move instead); else None."""
-        if not self.cfg["lookahead"] or tol > 0:
+        """Forward checking (``lookahead``: ``at_zero_tolerance``, ``always`` or ``none``): when object ``order[i]``
+        placed as in ``room`` leaves a later floor object it has a planned spatial edge with no free cell in every
+        band of its placed anchors (two at least), those other anchors (what to move instead); else None."""
+        mode = self.cfg["lookahead"]
+        if mode == "none" or (mode == "at_zero_tolerance" and tol > 0):
             return None
         v = self.plan.ids[self.order[i]]
         for j in self.order[i + 1:]:
