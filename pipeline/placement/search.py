@@ -14,7 +14,9 @@ sized to the object (``per_object``: a share of its smaller half extent, growing
 growing with the scene's backtracks). With ``keep_relations``, a candidate that breaks some of its relations within that
 tolerance is kept only when the object's remaining samples find none that keeps them all (the cheapest such candidate is
 taken). With ``early_backtrack``, an object at zero tolerance whose planned bands share no free cell backtracks at once
-instead of spending its samples. A scene fails, with its reason, when the backtrack or candidate budget runs out (or the
+instead of spending its samples. With ``lookahead`` (forward checking), a candidate that leaves a later floor object
+it is planned to relate to no free cell in every band of that object's placed anchors is refused (at zero tolerance
+only, or ``always``). A scene fails, with its reason, when the backtrack or candidate budget runs out (or the
 time budget, a safety net: the one outcome a machine's speed can change), or an object's category has no training
 instance; with ``on_exhausted: drop``, such an object is left out instead (with the objects it supports) and the search
 goes on. A scene whose backtrack budget runs out starts over from scratch with a fresh seed, at most ``restarts`` times
