@@ -24,12 +24,14 @@ BIN = Path(sys.executable).parent
 COMPARE = ROOT / "tests" / "slurm" / "compare_runs.py"
 
 
-def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path | None = None,
+def snakemake(workdir: Path, *args: str, check: bool = True, extra_config: Path | list[Path] | None = None,
               env_extra: dict | None = None) -> subprocess.CompletedProcess:
-    """Snakemake as a user without an activated venv runs it: the venv's bin is NOT on PATH."""
+    """Snakemake as a user without an activated venv runs it: the venv's bin is NOT on PATH. ``extra_config``: one
+    config file or several (later ones win) over config/tiny.yaml."""
     path = os.pathsep.join(p for p in os.environ["PATH"].split(os.pathsep) if Path(p) != BIN)
     env = {**os.environ, "PATH": path, **(env_extra or {})}
-    configs = [str(ROOT / "config" / "tiny.yaml")] + ([str(extra_config)] if extra_config else [])
+    extra = [extra_config] if isinstance(extra_config, Path) else list(extra_config or [])
+    configs = [str(ROOT / "config" / "tiny.yaml"), *map(str, extra)]
     cmd = [str(BIN / "snakemake"), "--snakefile", str(ROOT / "Snakefile"), "--directory", str(workdir),
            "--configfile", *configs, "--cores", "2", *args]
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=900)
