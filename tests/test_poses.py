@@ -12,14 +12,16 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.geometry.frames import turn_error
+from pipeline.geometry.frames import to_local, turn_error
 from pipeline.geometry.function import REGIONS, back_to_wall, facing_angles, regions
 from pipeline.geometry.raycast import intersector_class
 from pipeline.placement.checks import Checker
-from pipeline.placement.layout import add_object, wall_frame, walls_of, with_objects
+from pipeline.placement.layout import add_object, box_frame, wall_frame, walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
+from pipeline.placement.proposers import Centred, Combined, FaceAway, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import instantiate
+from pipeline.placement.support import learn_centring
 
 from conftest import Room, default_config
 
@@ -195,6 +197,43 @@ def test_a_tv_planned_on_a_stand_faces_the_way_the_stand_faces(learned, kind):
             assert turn_error(tv[6] - math.radians(yaw)) <= math.radians(5), (kind, yaw, seed, tv)
 
 
+def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training_rooms():
+    # learned: the hand-built rooms' televisions stand on their stands' middles and chairs on their desks' centre
+    # lines, nightstands beside the bed's head (off its middle); 0.1 m off in both axes, no support rule
+    cfg = default_config()
+    learn = lambda rooms, least=10: learn_centring(rooms, 0.02, least, 0.02, cfg["floor_contact"])
+    rules = learn([furnished(s).room_input() for s in range(12)])
+    assert rules[("tv_stand", "tv", "support")] == (1.0, 1.0)
+    assert rules[("desk", "chair", "spatial")] == (1.0, 0.0) and ("bed", "nightstand", "spatial") not in rules
+    assert not any(kind == "support" for _, _, kind in learn([furnished(s).room_input() for s in range(9)]))  # too few
+    shifted = [furnished(s) for s in range(12)]
+    for r in shifted:
+        for o in r.objects:
+            if o["category"] == "tv":
+                o["cx"], o["cy"], o["px"], o["py"] = o["cx"] + 0.1, o["cy"] + 0.1, o["px"] + 0.1, o["py"] + 0.1
+    assert ("tv_stand", "tv", "support") not in learn([r.room_input() for r in shifted])
+    # applied: uniform places on the stand's top land anywhere on it; centred, on its middle (within float error)
+    room, walls, pool, checker, cfg = setup_room(furnished(0))
+    base = given(room, pool, "tv_stand", "stand", (0.2, 2.0), 270)
+    plan = plan_of("t", "tv", [PlanEdge("stand", "t", "support", None, None)], parent="stand")
+    uniform = Combined(UniformLocation(), FaceAway())
+    offset = lambda proposer, seed: np.abs(to_local(box_frame(base.boxes[0]), placed(
+        instantiate(plan, base, walls, [0], proposer, pool, checker, cfg["instantiate"], seed), "t")[:2]))
+    assert max(offset(uniform, seed).max() for seed in SEEDS) > 0.05
+    centred = Centred(uniform, {("tv_stand", "tv", "support"): (1.0, 1.0)})
+    assert max(offset(centred, seed).max() for seed in SEEDS) < 1e-9
+    across = Centred(uniform, {("tv_stand", "tv", "support"): (1.0, 0.0)})  # across only: the depth stays drawn
+    offs = np.array([offset(across, seed) for seed in SEEDS])
+    assert offs[:, 0].max() < 1e-9 and offs[:, 1].max() > 0.01
+    # a chair planned in front of a desk: on the desk's centre line across it, wherever the band put it
+    desk = given(room, pool, "desk", "desk", (2.2, 0.3), 0)
+    plan = plan_of("c", "chair", [PlanEdge("desk", "c", "spatial", "front", "adjacent")])
+    chair = Centred(Combined(RelationPrior(cfg["extract"]), FaceAway()), {("desk", "chair", "spatial"): (1.0, 0.0)})
+    for seed in SEEDS:
+        c = placed(instantiate(plan, desk, walls, [0], chair, pool, checker, cfg["instantiate"], seed), "c")
+        assert abs(to_local(box_frame(desk.boxes[0]), c[:2])[0]) < 1e-9, seed
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("kind", ["cfcn", "prior"])
 def test_a_chair_planned_in_front_of_a_desk_faces_it(learned, kind):
@@ -224,6 +263,34 @@ def test_a_symmetric_objects_equivalent_turns_are_one_turn():
     wardrobe = np.array([[2.0, 3.7, 1.0, 0.5, 0.3, 1.0, 0.0]])  # its front against the top wall
     assert not back_to_wall(wardrobe, r.outline, 0.1, math.radians(15))[0]  # its literal back faces into the room
     assert back_to_wall(wardrobe, r.outline, 0.1, math.radians(15), ["rotational-2"])[0]  # its equivalent back does not
+
+
+def test_a_symmetric_anchors_regions_count_in_every_frame_it_cannot_be_told_apart_from():
+    """A sofa behind a rotational-2 coffee table's literal front stands in its front region once the table is turned
+    half a turn (the same table from above), so the learned check 'sofa in front of the coffee table' passes; behind a
+    left-right sofa-side table it stays behind. A rotational-4 table adds its quarter turns."""
+    from pipeline.evaluation import functional
+    from pipeline.geometry.function import equivalent_regions
+
+    def living(yaw: float, kind: str):
+        r = Room([(0, 0), (5, 0), (5, 5), (0, 5)], room_type="living")
+        r.add("sofa", "sofa", (2.0, 0.9, 0.8), (2.5, 0.6), 0).add("ct", "coffee_table", (1.2, 0.6, 0.4), (2.5, 1.8), yaw)
+        return r.room_input(), {"m_sofa": "left-right", "m_ct": kind}
+
+    room, sym = living(0.0, "rotational-2")  # the table's literal front (+y) turned away from the sofa
+    assert REGIONS[regions(room.boxes)[1, 0]] == "back"
+    assert {REGIONS[k] for k in equivalent_regions(room.boxes, ["left-right", "rotational-2"])[:, 1, 0]} == {"back", "front"}
+    assert {REGIONS[k] for k in equivalent_regions(room.boxes, ["left-right", "left-right"])[:, 1, 0]} == {"back"}
+    assert len(equivalent_regions(room.boxes, ["left-right", "rotational-4"])) == 4
+    cfg = {**default_config()["evaluate"]["functional"], "min_share": 0.85}
+    train = [living(180.0, "rotational-2")[0] for _ in range(25)]  # its front towards the sofa
+    checks = functional.learn_checks(train, cfg, {"m_sofa": "left-right", "m_ct": "rotational-2"})
+    assert any(c.get("anchor") == "coffee_table" and c["target"] == "sofa" and c["region"] == "front"
+               for c in checks["checks"])
+    assert functional.score_room(room, checks, cfg, sym)["fn:sofa@coffee_table"] == 1.0
+    room, sym = living(0.0, "none")  # a table with one front, turned away: the check fails
+    checks = functional.learn_checks(train, cfg, {"m_sofa": "left-right", "m_ct": "none"})
+    assert functional.score_room(room, checks, cfg, sym)["fn:sofa@coffee_table"] == 0.0
 
 
 @pytest.mark.parametrize("side,distance", [("left", "adjacent"), ("front", "proximal"), ("right", "adjacent")])

@@ -12,7 +12,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..geometry.function import REGIONS, back_to_wall, facing_angles, plan_gaps, regions
+from ..geometry.function import REGIONS, back_to_wall, equivalent_regions, facing_angles, plan_gaps
 from ..room import RoomInput
 from ..room.contents import implausible, learn_contents, wilson_lower
 
@@ -53,16 +53,18 @@ def kinds(room: RoomInput, symmetry: dict[str, str] | None) -> list[str] | None:
 
 
 def predicate_masks(room: RoomInput, preds: list[Predicate], cfg: dict[str, Any], symmetry: dict[str, str] | None = None) -> np.ndarray:
-    """``(p, n, n)`` bool: predicate ``p`` holds for target ``j`` around anchor ``i`` (never ``i == j``); facing
-    counts a symmetric target's equivalent fronts (``symmetry``: model id -> type)."""
+    """``(p, n, n)`` bool: predicate ``p`` holds for target ``j`` around anchor ``i`` (never ``i == j``); the region
+    holds in any frame a symmetric anchor cannot be told apart from, the facing counts a symmetric target's
+    equivalent fronts (``symmetry``: model id -> type)."""
     n = len(room.object_ids)
-    region, gap, angle = regions(room.boxes), plan_gaps(room.boxes), facing_angles(room.boxes, kinds(room, symmetry))
+    kind = kinds(room, symmetry)
+    region, gap, angle = equivalent_regions(room.boxes, kind), plan_gaps(room.boxes), facing_angles(room.boxes, kind)
     lim = np.radians(cfg["facing_angle"])
     facing = {"any": np.ones((n, n), bool), "faces": angle <= lim, "away": angle >= np.pi - lim}
     out = np.empty((len(preds), n, n), bool)
     for k, p in enumerate(preds):
         allowed = REGION_SETS[p.region]
-        where = np.ones((n, n), bool) if allowed is None else np.isin(region, [REGIONS.index(r) for r in allowed])
+        where = np.ones((n, n), bool) if allowed is None else np.isin(region, [REGIONS.index(r) for r in allowed]).any(0)
         out[k] = where & (gap <= (np.inf if p.gap is None else p.gap)) & facing[p.facing]
     out[:, np.arange(n), np.arange(n)] = False
     return out

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .boxes import footprint_corners, footprint_overlap, rotation
-from .frames import FOLD, turn_error, wrap
+from .frames import FOLD, RADIAL_FRAMES, turn_error, wrap
 from .polygon import inward_normals, make_ccw, polygon_segments
 
 REGIONS = ("front", "back", "side_front", "side_back", "corner", "over")
@@ -37,6 +37,23 @@ def regions(boxes: np.ndarray) -> np.ndarray:
     wide, long = np.abs(u) > 1.0, np.abs(v) > 1.0
     out = np.where(wide & long, 4, np.where(wide, np.where(v >= 0, 2, 3), np.where(long, np.where(v > 0, 0, 1), 5)))
     return out.astype(np.int8)
+
+
+def equivalent_regions(boxes: np.ndarray, symmetry: ArrayLike | None = None) -> np.ndarray:
+    """``(t, n, n)`` index into :data:`REGIONS` of target ``j``'s centre in each frame anchor ``i`` cannot be told
+    apart from (row: anchor): its own, and for a rotational-k anchor its frames turned by ``2 pi m / k``, for a radial
+    one by ``2 pi m /`` :data:`~pipeline.geometry.frames.RADIAL_FRAMES` (mirrors change no region). A rotational-2
+    coffee table turned by half a turn holds the sofa in its front region in one of its frames. Anchors with fewer
+    frames repeat their own; ``symmetry (n,)``: each object's type (None: literal fronts, ``t`` = 1)."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    kinds = ["none"] * len(b) if symmetry is None else list(np.asarray(symmetry, object))
+    k = np.array([RADIAL_FRAMES if s == "radial" else max(FOLD.get(s, 1), 1) for s in kinds], int)
+    out = []
+    for m in range(int(k.max(initial=1))):
+        turned = b.copy()
+        turned[:, 6] += 2 * np.pi * (m % k) / k
+        out.append(regions(turned))
+    return np.stack(out)
 
 
 def sides(boxes: np.ndarray) -> np.ndarray:

@@ -12,10 +12,10 @@ import numpy as np
 
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d
-from ..geometry.frames import to_local
+from ..geometry.frames import to_local, to_world
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
-from .anchors import Anchor
+from .anchors import SUPPORT, Anchor
 from .layout import wall_frame
 
 
@@ -195,3 +195,32 @@ class Masked(DensityProposer):
 
     def orientation(self, *args) -> float:
         return self.base.orientation(*args)
+
+
+class Centred:
+    """A proposer whose objects stand on their anchors' centre lines as often as the training rooms' do: ``rules``
+    maps (anchor category, object category, ``support`` | ``spatial``) to the shares ``(across, along)`` of
+    :func:`~pipeline.placement.support.learn_centring`. On a support, with each share's probability the drawn place's
+    offset across (along) the support is set to 0; beside a placed floor anchor planned in front of or behind it, the
+    offset across it, and planned left or right of it, the offset along it. A drawn place is only as fine as the
+    proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
+    proposer's."""
+
+    def __init__(self, base, rules: dict[tuple[str, str, str], tuple[float, float]]):
+        self.base, self.rules = base, rules
+
+    def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        drawn = self.base.pose(req, rng)
+        if drawn is None:
+            return None
+        xy, yaw = drawn
+        for a in req.anchors:
+            rule = None if a.obj is None or a.reverse else self.rules.get((req.room.categories[a.obj], req.category, a.kind))
+            if rule is None:
+                continue
+            share = np.asarray(rule) if a.kind == SUPPORT else (
+                np.array([rule[0], 0.0]) if a.direction in ("front", "back") else np.array([0.0, rule[1]]))
+            local = to_local(a.frame, xy)
+            local[rng.random(2) < share] = 0.0
+            xy = to_world(a.frame, local)
+        return xy, yaw

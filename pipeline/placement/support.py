@@ -6,17 +6,25 @@ check for that category, never raises it, and never below ``least`` (0.5: half t
 (docs/departures.md).
 
 A training object's support is geometric: the object whose box top lies within ``tolerance`` m of its bottom and
-whose footprint holds the most of it; the share is the check's own :func:`~pipeline.placement.checks.support_share`."""
+whose footprint holds the most of it; the share is the check's own :func:`~pipeline.placement.checks.support_share`.
+
+Where on its support an object stands, learned the same way (:func:`learn_centring`): per (support category, object
+category), the share of the training pairs whose object stands on the support's centre line across it (local x) and
+along it (local y); the search's proposers draw a place at the resolution of their grid or network (PlanIT's location
+network: 0.15 m per pixel at the default preset), finer than which a television is not centred on its stand."""
 from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.frames import to_local
 from ..room import RoomInput
 from .checks import support_share
+from .layout import box_frame
 
 
-def supported_shares(room: RoomInput, tolerance: float, floor_contact: float) -> list[tuple[str, float]]:
-    """(category, share of its footprint over its support) for every object of the room standing on another."""
+def support_pairs(room: RoomInput, tolerance: float, floor_contact: float) -> list[tuple[int, int, float]]:
+    """(object, its support, share of its footprint over it) for every object of the room standing on another
+    (indices into the room's objects)."""
     b = room.boxes.reshape(-1, 7)
     bottom, top = b[:, 2] - b[:, 5], b[:, 2] + b[:, 5]
     out = []
@@ -24,8 +32,13 @@ def supported_shares(room: RoomInput, tolerance: float, floor_contact: float) ->
         below = np.flatnonzero((np.abs(top - bottom[k]) <= tolerance) & (np.arange(len(b)) != k))
         shares = [support_share(b[k], b[j]) for j in below]
         if shares and max(shares) > 0:
-            out.append((room.categories[k], max(shares)))
+            out.append((int(k), int(below[int(np.argmax(shares))]), max(shares)))
     return out
+
+
+def supported_shares(room: RoomInput, tolerance: float, floor_contact: float) -> list[tuple[str, float]]:
+    """(category, share of its footprint over its support) for every object of the room standing on another."""
+    return [(room.categories[k], share) for k, _, share in support_pairs(room, tolerance, floor_contact)]
 
 
 def learn_support_floor(rooms: list[RoomInput], cfg: dict, floor_contact: float) -> dict[str, float]:
@@ -41,3 +54,33 @@ def learn_support_floor(rooms: list[RoomInput], cfg: dict, floor_contact: float)
     floor = {c: max(float(np.quantile(s, learned["quantile"])), learned["least"])
              for c, s in seen.items() if len(s) >= learned["min_pairs"]}
     return {c: round(f, 3) for c, f in sorted(floor.items()) if f < cfg["min_support"]}
+
+
+def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float,
+                   floor_contact: float) -> dict[tuple[str, str, str], tuple[float, float]]:
+    """(anchor category, object category, ``support`` | ``spatial``) -> the shares ``(across, along)`` of the training
+    rooms' pairs whose object's centre lies within ``within`` m of the anchor's centre line across it (local x = 0)
+    and along it (local y = 0). ``support``: an object and the support it stands on (both lines); ``spatial``: two
+    floor objects, across over the pairs whose object stands in the anchor's front or back region, along over those
+    in its side regions. A share needs ``min_pairs`` pairs (else 0); rules whose shares are both 0 are left out."""
+    seen: dict[tuple[str, str, str], list[list[bool]]] = {}
+    for room in rooms:
+        b, cats = room.boxes.reshape(-1, 7), room.categories
+        for k, j, _ in support_pairs(room, tolerance, floor_contact):
+            u, v = np.abs(to_local(box_frame(b[j]), b[k, :2]))
+            lines = seen.setdefault((cats[j], cats[k], "support"), [[], []])
+            lines[0].append(bool(u <= within))
+            lines[1].append(bool(v <= within))
+        floor = np.flatnonzero(b[:, 2] - b[:, 5] <= floor_contact)
+        for a in floor:
+            across, along = np.abs(to_local(box_frame(b[a]), b[floor, :2])).T
+            for t, u, v in zip(floor, across, along):
+                if t != a and (u <= b[a, 3]) != (v <= b[a, 4]):  # in the front / back region, or in a side region
+                    lines = seen.setdefault((cats[a], cats[t], "spatial"), [[], []])
+                    if u <= b[a, 3]:
+                        lines[0].append(bool(u <= within))
+                    else:
+                        lines[1].append(bool(v <= within))
+    share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
+    rules = {key: (round(share(across), 3), round(share(along), 3)) for key, (across, along) in sorted(seen.items())}
+    return {key: r for key, r in rules.items() if r != (0.0, 0.0)}

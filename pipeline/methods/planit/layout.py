@@ -20,6 +20,7 @@ from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from ...placement.search import SCORED, instantiate
+from ...placement.support import learn_centring
 from ...seeding import seed_of
 from ..interface import Corpus, Scene, Task
 from ..placing import Context, load_context, scene_of
@@ -29,10 +30,28 @@ from .nets.train import KIND
 log = logging.getLogger("planit.instantiate")
 
 
-def make_proposer(location: str, saved, cfg: dict, extract: dict):
+def make_proposer(location: str, saved, cfg: dict, extract: dict, centring: dict | None = None):
     """The variant's proposer (``cfg``: its instantiate settings, ``extract``: the extraction's): the pose networks
     (their densities weighted by the relation bands when ``relation_mask``), the relative-pose prior (likewise), or
-    uniform or rule-band locations with the networks' orientations."""
+    uniform or rule-band locations with the networks' orientations; objects on a support centred on its centre lines
+    by the training rooms' ``centring`` shares when the variant snaps (:class:`~pipeline.placement.proposers.Centred`)."""
+    base = location_proposer(location, saved, cfg, extract)
+    return proposers.Centred(base, centring) if centring and cfg["snap"]["enabled"] else base
+
+
+def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], tuple[float, float]]:
+    """The training rooms' centre-line shares of objects on supports and beside floor anchors
+    (:func:`~pipeline.placement.support.learn_centring`, ``instantiate.snap``'s settings)."""
+    snap = config["instantiate"]["snap"]
+    rules = learn_centring(corpus.training(), snap["centre_within"], snap["centre_min_pairs"],
+                           config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"])
+    if rules:
+        log.info("%s: centre-line shares from the training rooms: %s", corpus.room_type,
+                 {"/".join(key): v for key, v in rules.items()})
+    return rules
+
+
+def location_proposer(location: str, saved, cfg: dict, extract: dict):
     bands = proposers.RelationPrior(extract, soft=cfg["band_softness"], slack=cfg["band_slack"])
     if location == "prior":
         return PosePrior.from_record(saved.record, bands if cfg["relation_mask"] else None)
@@ -111,7 +130,8 @@ class PlanitLayout:
         if not plans:
             log.warning("%s: no graph of room type '%s' to place: writing empty tables", task.graphs[0],
                         task.corpus.room_type)
-        proposer = make_proposer(self.variant["location"], saved, self.settings, self.config["extract"])
+        proposer = make_proposer(self.variant["location"], saved, self.settings, self.config["extract"],
+                                 centring_rules(self.config, task.corpus))
         scored, bar = 0, iter(progress(range(count), desc=f"instantiate {task.corpus.room_type} ({self.name})"))
         for plan in plans:
             if scored >= count:
@@ -144,7 +164,8 @@ class CompleteRoom:
             raise InputError(f"keep: {self.keep}, but room {self.room} has {len(plan.ids)} objects")
         saved = checkpoint.load(task.model, KIND)
         ctx = load_context(self.config, task.corpus)
-        proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"])
+        proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"],
+                                 centring_rules(self.config, task.corpus))
         seed = seed_of(self.config["seed"], "complete", plan.scene_id)
         outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)
         yield scene_of(plan, ctx, outcome, walls)
