@@ -201,7 +201,7 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
     # learned: the hand-built rooms' televisions stand on their stands' middles and chairs on their desks' centre
     # lines, nightstands beside the bed's head (off its middle); 0.1 m off in both axes, no support rule
     cfg = default_config()
-    learn = lambda rooms, least=10: learn_centring(rooms, 0.02, least, 0.02, cfg["floor_contact"])
+    learn = lambda rooms, least=10: learn_centring(rooms, 0.02, least, 0.02, cfg["floor_contact"], math.pi / 4)
     rules = learn([furnished(s).room_input() for s in range(12)])
     assert rules[("tv_stand", "tv", "support")] == (1.0, 1.0)
     assert rules[("desk", "chair", "spatial")] == (1.0, 0.0) and ("bed", "nightstand", "spatial") not in rules
@@ -232,6 +232,41 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
     for seed in SEEDS:
         c = placed(instantiate(plan, desk, walls, [0], chair, pool, checker, cfg["instantiate"], seed), "c")
         assert abs(to_local(box_frame(desk.boxes[0]), c[:2])[0]) < 1e-9, seed
+
+
+def test_two_objects_facing_each_other_stand_on_one_axis_as_in_the_training_rooms_planned_edge_or_not():
+    # learned: the hand-built rooms' chairs face their desks on the desk's centre line (both ways round); a chair
+    # 0.1 m off it, or one turned away, gives no rule; the bed and the desk stand back to back, not facing
+    cfg = default_config()
+    learn = lambda rooms: learn_centring(rooms, 0.02, 10, 0.02, cfg["floor_contact"], math.pi / 4)
+    rules = learn([furnished(s).room_input() for s in range(12)])
+    assert rules[("desk", "chair", "facing")] == (1.0, 0.0) and rules[("chair", "desk", "facing")] == (1.0, 0.0)
+    assert not any(key[2] == "facing" and "bed" in key for key in rules)
+    for dx, turn in ((0.1, 0.0), (0.0, 90.0)):
+        moved = [furnished(s) for s in range(12)]
+        for r in moved:
+            for o in r.objects:
+                if o["category"] == "chair":
+                    o["cx"], o["cy"], o["px"], o["py"] = o["cx"] + dx, o["cy"] + dx, o["px"] + dx, o["py"] + dx
+                    o["yaw"] = o["yaw"] + math.radians(turn)
+        assert ("desk", "chair", "facing") not in learn([r.room_input() for r in moved]), (dx, turn)
+    # applied: a chair planned only against the top wall (no edge to the desk at the bottom wall) faces the desk from
+    # wherever the band puts it along that wall; with the rule, on the desk's centre line
+    room, walls, pool, checker, cfg = setup_room(furnished(0))
+    desk = given(room, pool, "desk", "desk", (2.7, 0.3), 0)
+    plan = plan_of("c", "chair", [PlanEdge(walls.ids[2], "c", "spatial", "front", "adjacent")])
+    drawn = Combined(RelationPrior(cfg["extract"]), FaceAway())
+    across = lambda proposer, seed: to_local(box_frame(desk.boxes[0]), placed(
+        instantiate(plan, desk, walls, [0], proposer, pool, checker, cfg["instantiate"], seed), "c")[:2])[0]
+    assert max(abs(across(drawn, seed)) for seed in SEEDS) > 0.3
+    centred = Centred(drawn, {("desk", "chair", "facing"): (1.0, 0.0)})
+    assert max(abs(across(centred, seed)) for seed in SEEDS) < 1e-9
+    # not when it would stand beside the desk rather than across from it: a chair planned against the right wall
+    side = plan_of("c", "chair", [PlanEdge(walls.ids[1], "c", "spatial", "front", "adjacent")])
+    beside = [to_local(box_frame(desk.boxes[0]), placed(instantiate(side, desk, walls, [0], centred, pool, checker,
+                                                                    cfg["instantiate"], seed), "c")[:2])[0]
+              for seed in SEEDS]
+    assert min(abs(u) for u in beside) > 1.0
 
 
 @pytest.mark.slow

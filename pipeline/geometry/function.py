@@ -114,6 +114,18 @@ def facing_angles(boxes: np.ndarray, symmetry: ArrayLike | None = None) -> np.nd
     return turn_error(angle, "none" if symmetry is None else np.asarray(symmetry, object)[None, :])
 
 
+def facing_each_other(boxes: np.ndarray, limit: float) -> np.ndarray:
+    """``(n, n)`` bool: target ``j``'s front lies within ``limit`` rad of the direction to anchor ``i``'s footprint and
+    ``i``'s front within ``limit`` of the direction to ``j``'s centre (literal fronts; row: anchor, diagonal False). A
+    sofa and the television stand across the room from it; a box of zero extents is a candidate centre."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    centres = b.copy()
+    centres[:, 3:6] = 0.0
+    out = (facing_angles(b) <= limit) & (facing_angles(centres).T <= limit)
+    np.fill_diagonal(out, False)
+    return out
+
+
 def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_angle: float,
                  symmetry: ArrayLike | None = None) -> np.ndarray:
     """``(n,)`` bool: the object's back faces a wall of the floor ``outline (k, 2)`` (its back normal within

@@ -13,10 +13,11 @@ import numpy as np
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d
 from ..geometry.frames import to_local, to_world
+from ..geometry.function import facing_each_other
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
-from .layout import wall_frame
+from .layout import box_frame, wall_frame
 
 
 @dataclass
@@ -199,15 +200,17 @@ class Masked(DensityProposer):
 
 class Centred:
     """A proposer whose objects stand on their anchors' centre lines as often as the training rooms' do: ``rules``
-    maps (anchor category, object category, ``support`` | ``spatial``) to the shares ``(across, along)`` of
-    :func:`~pipeline.placement.support.learn_centring`. On a support, with each share's probability the drawn place's
-    offset across (along) the support is set to 0; beside a placed floor anchor planned in front of or behind it, the
-    offset across it, and planned left or right of it, the offset along it. A drawn place is only as fine as the
-    proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
+    maps (anchor category, object category, ``support`` | ``spatial`` | ``facing``) to the shares ``(across, along)``
+    of :func:`~pipeline.placement.support.learn_centring`. On a support, with each share's probability the drawn
+    place's offset across (along) the support is set to 0; beside a placed floor anchor planned in front of or behind
+    it, the offset across it, and planned left or right of it, the offset along it; a floor object facing a placed object with
+    no planned edge to it, the two facing each other within ``facing`` rad at the drawn pose
+    (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it. A drawn place is only as fine as
+    the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
     proposer's."""
 
-    def __init__(self, base, rules: dict[tuple[str, str, str], tuple[float, float]]):
-        self.base, self.rules = base, rules
+    def __init__(self, base, rules: dict[tuple[str, str, str], tuple[float, float]], facing: float = np.pi / 4):
+        self.base, self.rules, self.facing = base, rules, facing
 
     def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
         drawn = self.base.pose(req, rng)
@@ -220,7 +223,26 @@ class Centred:
                 continue
             share = np.asarray(rule) if a.kind == SUPPORT else (
                 np.array([rule[0], 0.0]) if a.direction in ("front", "back") else np.array([0.0, rule[1]]))
-            local = to_local(a.frame, xy)
-            local[rng.random(2) < share] = 0.0
-            xy = to_world(a.frame, local)
+            xy = self._onto_line(a.frame, xy, share, rng)
+        planned = {a.obj for a in req.anchors}
+        for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
+            if o not in planned:
+                share = np.array([self.rules[(req.room.categories[o], req.category, "facing")][0], 0.0])
+                xy = self._onto_line(box_frame(req.room.boxes[o]), xy, share, rng)
         return xy, yaw
+
+    def _facing(self, req: Request, xy: np.ndarray, yaw: float) -> np.ndarray:
+        """Indices of the placed objects with a ``facing`` rule for the requested category that face each other with
+        the drawn pose."""
+        ruled = np.array([(c, req.category, "facing") in self.rules for c in req.room.categories], bool)
+        if not ruled.any():
+            return np.zeros(0, int)
+        boxes = np.vstack([req.room.boxes.reshape(-1, 7), [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
+        return np.flatnonzero(ruled & facing_each_other(boxes, self.facing)[:-1, -1])
+
+    @staticmethod
+    def _onto_line(frame, xy: np.ndarray, share: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """``xy`` with its offset across (along) ``frame``'s centre line set to 0 with probability ``share (2,)``."""
+        local = to_local(frame, xy)
+        local[rng.random(2) < share] = 0.0
+        return to_world(frame, local)

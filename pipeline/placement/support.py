@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.frames import to_local
+from ..geometry.function import facing_each_other
 from ..room import RoomInput
 from .checks import support_share
 from .layout import box_frame
@@ -57,12 +58,14 @@ def learn_support_floor(rooms: list[RoomInput], cfg: dict, floor_contact: float)
 
 
 def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float,
-                   floor_contact: float) -> dict[tuple[str, str, str], tuple[float, float]]:
-    """(anchor category, object category, ``support`` | ``spatial``) -> the shares ``(across, along)`` of the training
-    rooms' pairs whose object's centre lies within ``within`` m of the anchor's centre line across it (local x = 0)
-    and along it (local y = 0). ``support``: an object and the support it stands on (both lines); ``spatial``: two
-    floor objects, across over the pairs whose object stands in the anchor's front or back region, along over those
-    in its side regions. A share needs ``min_pairs`` pairs (else 0); rules whose shares are both 0 are left out."""
+                   floor_contact: float, facing: float) -> dict[tuple[str, str, str], tuple[float, float]]:
+    """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the shares ``(across, along)`` of
+    the training rooms' pairs whose object's centre lies within ``within`` m of the anchor's centre line across it
+    (local x = 0) and along it (local y = 0). ``support``: an object and the support it stands on (both lines);
+    ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's front or back region,
+    along over those in its side regions; ``facing``: two floor objects facing each other within ``facing`` rad
+    (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the room), across.
+    A share needs ``min_pairs`` pairs (else 0); rules whose shares are both 0 are left out."""
     seen: dict[tuple[str, str, str], list[list[bool]]] = {}
     for room in rooms:
         b, cats = room.boxes.reshape(-1, 7), room.categories
@@ -81,6 +84,10 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
                         lines[0].append(bool(u <= within))
                     else:
                         lines[1].append(bool(v <= within))
+        facing_pairs = facing_each_other(b[floor], facing)
+        for a, t in zip(*np.nonzero(facing_pairs)):
+            u = abs(to_local(box_frame(b[floor[a]]), b[floor[t], :2])[0])
+            seen.setdefault((cats[floor[a]], cats[floor[t]], "facing"), [[], []])[0].append(bool(u <= within))
     share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
     rules = {key: (round(share(across), 3), round(share(along), 3)) for key, (across, along) in sorted(seen.items())}
     return {key: r for key, r in rules.items() if r != (0.0, 0.0)}

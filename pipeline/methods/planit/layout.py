@@ -36,7 +36,9 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, centring: dict
     uniform or rule-band locations with the networks' orientations; objects on a support centred on its centre lines
     by the training rooms' ``centring`` shares when the variant snaps (:class:`~pipeline.placement.proposers.Centred`)."""
     base = location_proposer(location, saved, cfg, extract)
-    return proposers.Centred(base, centring) if centring and cfg["snap"]["enabled"] else base
+    if not centring or not cfg["snap"]["enabled"]:
+        return base
+    return proposers.Centred(base, centring, np.radians(cfg["snap"]["centre_facing_angle"]))
 
 
 def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], tuple[float, float]]:
@@ -44,7 +46,8 @@ def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], t
     (:func:`~pipeline.placement.support.learn_centring`, ``instantiate.snap``'s settings)."""
     snap = config["instantiate"]["snap"]
     rules = learn_centring(corpus.training(), snap["centre_within"], snap["centre_min_pairs"],
-                           config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"])
+                           config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
+                           np.radians(snap["centre_facing_angle"]))
     if rules:
         log.info("%s: centre-line shares from the training rooms: %s", corpus.room_type,
                  {"/".join(key): v for key, v in rules.items()})
