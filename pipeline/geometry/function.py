@@ -22,12 +22,18 @@ from .polygon import inward_normals, make_ccw, polygon_segments
 REGIONS = ("front", "back", "side_front", "side_back", "corner", "over")
 
 
+def offsets(boxes: np.ndarray) -> np.ndarray:
+    """``(n, n, 2)`` each target ``j``'s centre in anchor ``i``'s frame (m; x right, y front; row: anchor)."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    rel = b[None, :, :2] - b[:, None, :2]  # (anchor, target, 2)
+    return cast(np.ndarray, np.einsum("aji,atj->ati", rotation(b[:, 6]), rel))  # R^T (world -> anchor's local)
+
+
 def _normalised(boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(n, n)`` each target ``j``'s centre in anchor ``i``'s frame, scaled by the anchor's half extents: ``u``
     (signed, +x right) and ``v`` (+y front)."""
     b = np.asarray(boxes, float).reshape(-1, 7)
-    rel = b[None, :, :2] - b[:, None, :2]  # (anchor, target, 2)
-    local = np.einsum("aji,atj->ati", rotation(b[:, 6]), rel)  # R^T (world -> anchor's local)
+    local = offsets(b)
     return local[..., 0] / np.maximum(b[:, None, 3], 1e-9), local[..., 1] / np.maximum(b[:, None, 4], 1e-9)
 
 

@@ -17,10 +17,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.frames import to_local
-from ..geometry.function import facing_each_other
+from ..geometry.function import REGIONS, facing_each_other, offsets, regions
 from ..room import RoomInput
 from .checks import support_share
 from .layout import box_frame
+
+FRONT, BACK, SIDE_FRONT, SIDE_BACK = (REGIONS.index(r) for r in ("front", "back", "side_front", "side_back"))
 
 
 def support_pairs(room: RoomInput, tolerance: float, floor_contact: float) -> list[tuple[int, int, float]]:
@@ -75,19 +77,13 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
             lines[0].append(bool(u <= within))
             lines[1].append(bool(v <= within))
         floor = np.flatnonzero(b[:, 2] - b[:, 5] <= floor_contact)
-        for a in floor:
-            across, along = np.abs(to_local(box_frame(b[a]), b[floor, :2])).T
-            for t, u, v in zip(floor, across, along):
-                if t != a and (u <= b[a, 3]) != (v <= b[a, 4]):  # in the front / back region, or in a side region
-                    lines = seen.setdefault((cats[a], cats[t], "spatial"), [[], []])
-                    if u <= b[a, 3]:
-                        lines[0].append(bool(u <= within))
-                    else:
-                        lines[1].append(bool(v <= within))
-        facing_pairs = facing_each_other(b[floor], facing)
-        for a, t in zip(*np.nonzero(facing_pairs)):
-            u = abs(to_local(box_frame(b[floor[a]]), b[floor[t], :2])[0])
-            seen.setdefault((cats[floor[a]], cats[floor[t]], "facing"), [[], []])[0].append(bool(u <= within))
+        fb, fcats = b[floor], [cats[k] for k in floor]
+        off, region = np.abs(offsets(fb)), regions(fb)  # (a, t, 2) m, (a, t) index into REGIONS
+        lined = ((np.isin(region, (FRONT, BACK)), "spatial", 0), (np.isin(region, (SIDE_FRONT, SIDE_BACK)), "spatial", 1),
+                 (facing_each_other(fb, facing), "facing", 0))
+        for pairs, kind, axis in lined:
+            for a, t in zip(*np.nonzero(pairs)):
+                seen.setdefault((fcats[a], fcats[t], kind), [[], []])[axis].append(bool(off[a, t, axis] <= within))
     share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
     rules = {key: (round(share(across), 3), round(share(along), 3)) for key, (across, along) in sorted(seen.items())}
     return {key: r for key, r in rules.items() if r != (0.0, 0.0)}

@@ -33,8 +33,9 @@ log = logging.getLogger("planit.instantiate")
 def make_proposer(location: str, saved, cfg: dict, extract: dict, centring: dict | None = None):
     """The variant's proposer (``cfg``: its instantiate settings, ``extract``: the extraction's): the pose networks
     (their densities weighted by the relation bands when ``relation_mask``), the relative-pose prior (likewise), or
-    uniform or rule-band locations with the networks' orientations; objects on a support centred on its centre lines
-    by the training rooms' ``centring`` shares when the variant snaps (:class:`~pipeline.placement.proposers.Centred`)."""
+    uniform or rule-band locations with the networks' orientations; objects put on the centre lines of their supports,
+    planned floor anchors and the placed objects they face by the training rooms' ``centring`` shares when the variant
+    snaps (:class:`~pipeline.placement.proposers.Centred`)."""
     base = location_proposer(location, saved, cfg, extract)
     if not centring or not cfg["snap"]["enabled"]:
         return base
@@ -42,7 +43,7 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, centring: dict
 
 
 def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], tuple[float, float]]:
-    """The training rooms' centre-line shares of objects on supports and beside floor anchors
+    """The training rooms' centre-line shares of objects on supports, beside floor anchors and facing each other
     (:func:`~pipeline.placement.support.learn_centring`, ``instantiate.snap``'s settings)."""
     snap = config["instantiate"]["snap"]
     rules = learn_centring(corpus.training(), snap["centre_within"], snap["centre_min_pairs"],
