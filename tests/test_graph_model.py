@@ -75,6 +75,30 @@ def test_invalid_graphs_are_named():
     assert graph_checks.problems(cls, [0, chain, 0, 0], ok, 1, seen) == ["inconsistent_chain"]
 
 
+def test_link_rules_hold_on_the_graphs_they_are_learned_from_and_name_what_breaks_them(bedrooms):
+    """Every training graph keeps the link rules learned from them; a nightstand with no bed beside it is
+    ``missing_link``, a bed with two lamps on it where every training bed holds at most one is ``excess_link``."""
+    _, graphs = bedrooms
+    rules = graph_checks.learn_links(graphs, 0.5)
+    assert rules.required and rules.caps
+    assert all(not graph_checks.link_problems(g.node_class.tolist(), [tuple(e) for e in g.edges.tolist()], g.n_arch, rules)
+               for g in graphs)
+    # wall 0; bed 1, nightstand 2, lamp 3; classes: 0 wall, 3 bed, 4 nightstand, 5 lamp
+    cls = [0, 3, 4, 5]
+    sup, left = OBJECT_EDGES.index("support"), OBJECT_EDGES.index("left/adjacent")
+    wall = OBJECT_EDGES.index("front/adjacent")
+    ok = [(0, 1, wall), (1, 2, left), (2, 3, sup)]
+    hand = graph_checks.learn_links([Graph("r", ["w", "b", "n", "l"], np.array(cls), np.zeros(4, int), np.zeros(4, int),
+                                           np.zeros(4), 1, np.array(ok), np.zeros(3))], 0.0)
+    assert hand.required[4] == {(3, "left", "in"), (5, "support", "out")}
+    assert graph_checks.link_problems(cls, ok, 1, hand) == []
+    assert graph_checks.link_problems(cls, [(0, 1, wall), (0, 2, wall), (2, 3, sup)], 1, hand) == ["missing_link"]
+    assert graph_checks.link_problems(cls + [5], ok + [(2, 4, sup)], 1, hand) == ["excess_link"]
+    assert graph_checks.problems(cls + [5], [0] * 5, ok + [(2, 4, sup)], 1, {(a, b, c) for a, b, c in
+                                 [(0, 3, wall), (3, 4, left), (4, 5, sup)]}, links=hand) == ["excess_link"]
+    assert graph_checks.link_problems(cls + [5], ok + [(2, 4, sup)], 1, graph_checks.learn_links([], 0.0)) == []
+
+
 def bed_lamp_graph(real: Graph, vocab) -> Graph:
     """A real room's architecture holding a bed against wall_1, a nightstand on its left and a lamp on that."""
     a = real.n_arch
@@ -310,7 +334,7 @@ def test_a_room_string_is_read_back_into_its_room_and_broken_ones_are_rejected_b
     from test_strings import isomorphic
 
     vocab, graphs = bedrooms
-    rules = Rules(graphs, vocab, "neighbour", {"cap_counts": True, "required_share": 0.95})
+    rules = Rules(graphs, vocab, "neighbour", {"cap_counts": True, "required_share": 0.95, "links": "required"})
     room = graphs[0]
     text = serialize_room(string_graph(room, vocab), room.n_arch, np.random.default_rng(1))
     grown, bad = to_grown(text, room, vocab, rules)

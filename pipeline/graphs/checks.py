@@ -6,19 +6,78 @@ categories in training, has an inconsistent chain (a chain member with no adjace
 chain member; kitchen rows mix categories), or lacks a category (nearly) every training room holds
 (:func:`pipeline.room.contents.learn_contents`), or puts an object adjacent or proximal to two opposite walls
 (:func:`near_opposite_walls`: no real graph of the AI2-THOR rooms does, 5 of 10,000 objects of the procedural ones;
-the categories the training graphs show doing it are allowed).
+the categories the training graphs show doing it are allowed), or breaks a link rule of the training graphs
+(:func:`learn_links`: an office chair with no desk in front of it, a desk with two chairs planned in front of it).
 """
 from __future__ import annotations
 
+from collections import Counter
+from dataclasses import dataclass, field
+
 import networkx as nx
 
+from ..room.contents import wilson_lower
 from .data import EDGE_CLASSES, N_OBJECT_EDGES, OBJECT_EDGES, ROLES
 
 CHAIN_ROLES = {ROLES.index("chain"), ROLES.index("hub+chain")}
 NEAR = {k for k, name in enumerate(OBJECT_EDGES) if name.endswith(("adjacent", "proximal"))}
 OPPOSITE = EDGE_CLASSES.index("wall_opposite")
 REASONS = ("empty", "disconnected", "cyclic", "unseen_edge", "inconsistent_chain", "missing_required",
-           "near_opposite_walls")
+           "near_opposite_walls", "missing_link", "excess_link")
+Link = tuple[int, str, str]  # (the other node's class, support | a near edge's direction, "in" | "out")
+
+
+@dataclass(frozen=True)
+class LinkRules:
+    """What the training graphs' objects show of their near edges (:func:`learn_links`): per node class, the links
+    (nearly) every one of its objects has, and the most objects of a class one object links to one way."""
+    required: dict[int, frozenset[Link]] = field(default_factory=dict)
+    caps: dict[tuple[int, Link], int] = field(default_factory=dict)
+
+
+def node_links(node_class: list[int], edges: list[tuple[int, int, int]]) -> list[Counter[Link]]:
+    """Per node: how many nodes of each class it is linked to by a support edge or an adjacent or proximal spatial
+    edge of each direction, as the edge's target (``in``) or its anchor (``out``)."""
+    out: list[Counter[Link]] = [Counter() for _ in node_class]
+    for s, t, c in edges:
+        if c == 0 or c in NEAR:
+            kind = OBJECT_EDGES[c].split("/")[0]
+            out[t][(node_class[s], kind, "in")] += 1
+            out[s][(node_class[t], kind, "out")] += 1
+    return out
+
+
+def learn_links(graphs, min_share: float, cap: bool = True) -> LinkRules:
+    """From the training ``graphs`` (objects with ``node_class``, ``edges`` and ``n_arch``): per object class the links
+    whose share of its objects is confidently (Wilson 95% lower bound) at least ``min_share``, and, with ``cap``, each
+    (class, link)'s largest count on one object."""
+    objects: Counter[int] = Counter()
+    having: Counter[tuple[int, Link]] = Counter()
+    caps: dict[tuple[int, Link], int] = {}
+    for g in graphs:
+        cls = [int(c) for c in g.node_class]
+        for k, links in enumerate(node_links(cls, [tuple(e) for e in g.edges.tolist()])[g.n_arch:], g.n_arch):
+            objects[cls[k]] += 1
+            for link, m in links.items():
+                having[(cls[k], link)] += 1
+                caps[(cls[k], link)] = max(caps.get((cls[k], link), 0), m)
+    required: dict[int, set[Link]] = {}
+    for (c, link), h in having.items():
+        if wilson_lower(h, objects[c]) >= min_share:
+            required.setdefault(c, set()).add(link)
+    return LinkRules({c: frozenset(v) for c, v in required.items()}, caps if cap else {})
+
+
+def link_problems(node_class: list[int], edges: list[tuple[int, int, int]], n_arch: int, rules: LinkRules) -> list[str]:
+    """``missing_link`` when an object lacks a link its class requires, ``excess_link`` when it links to more objects
+    of a class one way than any training object of its class (a link never seen is the unseen-edge rule's)."""
+    out = []
+    links = node_links(node_class, edges)[n_arch:]
+    if any(not rules.required.get(node_class[k], frozenset()) <= set(lk) for k, lk in enumerate(links, n_arch)):
+        out.append("missing_link")
+    if any(m > rules.caps.get((node_class[k], link), m) for k, lk in enumerate(links, n_arch) for link, m in lk.items()):
+        out.append("excess_link")
+    return out
 
 
 def seen_triples(graphs) -> set[tuple[int, int, int]]:
@@ -33,9 +92,10 @@ def seen_triples(graphs) -> set[tuple[int, int, int]]:
 
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
              seen: set[tuple[int, int, int]], required: set[int] | frozenset[int] = frozenset(),
-             opposite_ok: set[int] | frozenset[int] = frozenset()) -> list[str]:
+             opposite_ok: set[int] | frozenset[int] = frozenset(), links: LinkRules = LinkRules()) -> list[str]:
     """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class); ``required``: node
-    classes every graph must hold; ``opposite_ok``: node classes that may stand near two opposite walls."""
+    classes every graph must hold; ``opposite_ok``: node classes that may stand near two opposite walls; ``links``:
+    the training graphs' link rules (:func:`learn_links`; none by default)."""
     out = [] if len(node_class) > n_arch else ["empty"]  # every real room holds an object
     n = len(node_class)
     undirected = nx.Graph()
@@ -55,7 +115,7 @@ def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int,
         out.append("missing_required")
     if any(node_class[k] not in opposite_ok for k in near_opposite_walls(node_class, edges)):
         out.append("near_opposite_walls")
-    return out
+    return out + link_problems(node_class, edges, n_arch, links)
 
 
 def near_walls(node_class: list[int], edges: list[tuple[int, int, int]]) -> dict[int, set[int]]:

@@ -21,6 +21,7 @@ from .. import tables
 from ..geometry.symmetry import TYPES as SYMMETRIES
 from ..log import progress
 from ..room.contents import learn_contents
+from . import checks as graph_checks
 from .data import ARCH, EDGE_CLASSES, N_OBJECT_EDGES, ROLES, Graph, Vocab
 
 
@@ -95,6 +96,14 @@ def contents_of(train: list, vocab, cfg: dict) -> tuple[np.ndarray | None, set[i
     cats = vocab.node_classes[len(ARCH):]
     caps = np.array([learned["max_count"].get(c, 0) for c in cats]) if cfg["cap_counts"] and train else None
     return caps, {vocab.node_classes.index(c) for c in learned["required"]}
+
+
+def link_rules(train: list, cfg: dict) -> graph_checks.LinkRules:
+    """The training graphs' link rules (:func:`pipeline.graphs.checks.learn_links` at ``cfg['required_share']``) a
+    sampled graph keeps to: ``cfg['links']`` ``all``, ``required`` (no caps) or ``none``."""
+    if cfg["links"] == "none":
+        return graph_checks.LinkRules()
+    return graph_checks.learn_links(train, cfg["required_share"], cfg["links"] == "all")
 
 
 def resample(n: int, budget: int, batch_size: int, base_seed: int, draw: Callable, desc: str) -> tuple[dict, int, Counter]:

@@ -12,7 +12,7 @@ import torch
 from ....errors import InputError
 from ....graphs import checks as graph_checks, data as graph_data
 from ....graphs.data import ARCH
-from ....graphs.generated import contents_of, graph_rows, resample
+from ....graphs.generated import contents_of, graph_rows, link_rules, resample
 from ....learning import checkpoint
 from ....seeding import seed_of
 from . import train
@@ -50,6 +50,7 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
     train_graphs = [g for g in graphs if g.room_id not in heldout_ids]
     caps, required = contents_of(train_graphs, vocab, sc["contents"])
     opposite_ok = graph_checks.opposite_classes(train_graphs)
+    links = link_rules(train_graphs, sc["contents"])
     plan = None
     if spec is not None:
         plan, arch_from = load_spec(spec, room_type, vocab)
@@ -61,7 +62,7 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
         raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
     n = count or sc["graphs"]
     base_seed = seed_of(config["seed"], room_type, Path(spec).name if spec else "")
-    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, (seen, caps, required, opposite_ok), plan, base_seed,
+    kept, first_try, reasons = _sample_valid(net, vocab, held, n, sc, (seen, caps, required, opposite_ok, links), plan, base_seed,
                                              saved["max_edges"], room_type)
     rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"gen_{room_type}")
     summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": n - len(kept),
@@ -79,14 +80,15 @@ def _plan_triples(plan) -> set[tuple[int, int, int]]:
 def _sample_valid(net, vocab, held, n, sc, rules, plan, base_seed, max_edges, room_type) -> tuple[dict, int, Counter]:
     """Graph index -> (valid graph, seed); how many were valid at the first try; rejections by reason. A graph that
     fails the checks is sampled again, up to ``resample_budget`` times. ``rules``: the seen edge triples, the count
-    caps and the required classes (:func:`contents_of`), and the classes the training graphs show near two opposite
-    walls."""
-    seen, caps, required, opposite_ok = rules
+    caps and the required classes (:func:`contents_of`), the classes the training graphs show near two opposite
+    walls and their link rules (:func:`link_rules`)."""
+    seen, caps, required, opposite_ok, links = rules
 
     def draw(part: list[int], seed: int) -> list:
         grown = sample(net, vocab, [held[i % len(held)] for i in part], seed, sc["temperature"], sc["max_objects"],
                        max_edges, [plan] * len(part) if plan else None, seen, caps, opposite_ok)
-        return [(g, graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen, required, opposite_ok))
+        return [(g, graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen, required, opposite_ok,
+                                          links))
                 for g in grown]
 
     return resample(n, sc["resample_budget"], sc["batch_size"], base_seed, draw, f"sample {room_type}")
