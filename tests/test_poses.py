@@ -21,7 +21,7 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Centred, Combined, FaceAway, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import instantiate
-from pipeline.placement.support import learn_centring
+from pipeline.placement.support import back_gap, learn_centring
 
 from conftest import Room, default_config
 
@@ -232,6 +232,47 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
     for seed in SEEDS:
         c = placed(instantiate(plan, desk, walls, [0], chair, pool, checker, cfg["instantiate"], seed), "c")
         assert abs(to_local(box_frame(desk.boxes[0]), c[:2])[0]) < 1e-9, seed
+
+
+def _tv_at_back(room: Room, gap: float) -> Room:
+    """``room`` with its TV moved along its stand to stand ``gap`` m from the stand's back edge."""
+    inp = room.room_input()
+    b = inp.boxes.reshape(-1, 7)
+    stand, tv = b[inp.object_ids.index("stand")], b[inp.object_ids.index("tv")]
+    d = (back_gap(stand, tv) - gap) * np.array([math.sin(stand[6]), -math.cos(stand[6])])  # towards the back
+    for o in room.objects:
+        if o["category"] == "tv":
+            o["cx"], o["cy"], o["px"], o["py"] = o["cx"] + d[0], o["cy"] + d[1], o["px"] + d[0], o["py"] + d[1]
+    return room
+
+
+def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_rooms():
+    # learned: televisions 1 cm from their stands' back edges give a back rule at that gap; centred ones (15 cm
+    # off it) or 5 cm off it (beyond flush_within, 3 cm) give none; too few pairs give none
+    cfg = default_config()
+    flush = cfg["instantiate"]["snap"]["flush_within"]
+    learn = lambda rooms, least=10: learn_centring(rooms, 0.02, least, 0.02, cfg["floor_contact"], math.pi / 4, flush)
+    centred = [furnished(s).room_input() for s in range(12)]
+    assert min(back_gap(r.boxes.reshape(-1, 7)[r.object_ids.index("stand")],
+                        r.boxes.reshape(-1, 7)[r.object_ids.index("tv")]) for r in centred) > flush
+    assert ("tv_stand", "tv", "back") not in learn(centred)
+    rules = learn([_tv_at_back(furnished(s), 0.01).room_input() for s in range(12)])
+    assert rules[("tv_stand", "tv", "back")] == (1.0, 0.01)
+    assert ("tv_stand", "tv", "back") not in learn([_tv_at_back(furnished(s), 0.05).room_input() for s in range(12)])
+    assert ("tv_stand", "tv", "back") not in learn([_tv_at_back(furnished(s), 0.01).room_input() for s in range(9)])
+    # applied: uniform places on the stand's top stand anywhere along it; with the rule, at its gap from the back edge,
+    # the offset across the stand still drawn
+    room, walls, pool, checker, cfg = setup_room(furnished(0))
+    base = given(room, pool, "tv_stand", "stand", (0.2, 2.0), 270)
+    plan = plan_of("t", "tv", [PlanEdge("stand", "t", "support", None, None)], parent="stand")
+    uniform = Combined(UniformLocation(), FaceAway())
+    tv = lambda proposer, seed: placed(instantiate(plan, base, walls, [0], proposer, pool, checker, cfg["instantiate"],
+                                                   seed), "t")
+    assert max(abs(back_gap(base.boxes[0], tv(uniform, seed)) - 0.01) for seed in SEEDS) > 0.02
+    at_back = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01)})
+    placed_tvs = [tv(at_back, seed) for seed in SEEDS]
+    assert max(abs(back_gap(base.boxes[0], t) - 0.01) for t in placed_tvs) < 1e-9
+    assert np.ptp([to_local(box_frame(base.boxes[0]), t[:2])[0] for t in placed_tvs]) > 0.01
 
 
 def test_two_objects_facing_each_other_stand_on_one_axis_as_in_the_training_rooms_planned_edge_or_not():

@@ -201,13 +201,15 @@ class Masked(DensityProposer):
 class Centred:
     """A proposer whose objects stand on their anchors' centre lines as often as the training rooms' do: ``rules``
     maps (anchor category, object category, ``support`` | ``spatial`` | ``facing``) to the shares ``(across, along)``
-    of :func:`~pipeline.placement.support.learn_centring`. On a support, with each share's probability the drawn
-    place's offset across (along) the support is set to 0; beside a placed floor anchor planned in front of or behind
-    it, the offset across it, and planned left or right of it, the offset along it; a floor object facing a placed object with
-    no planned edge to it, the two facing each other within ``facing`` rad at the drawn pose
-    (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it. A drawn place is only as fine as
-    the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
-    proposer's."""
+    of :func:`~pipeline.placement.support.learn_centring`. On a support, with the ``back`` rule's share the drawn place
+    moves along the support to stand the rule's gap from its back edge (a monitor at the back of its desk), else
+    with each share's probability the drawn place's offset across (along) the support is set to 0; beside a placed
+    floor anchor planned in front of or behind it, the offset across it, and planned left or right of it, the offset
+    along it; a floor object facing a placed object with no planned edge to it, the two facing each other within
+    ``facing`` rad at the drawn pose (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it.
+    A drawn place is only as fine as the proposer's grid or network (0.15 m per pixel for PlanIT's at the default
+    preset); the turn is the base proposer's.
+    """
 
     def __init__(self, base, rules: dict[tuple[str, str, str], tuple[float, float]], facing: float = np.pi / 4):
         self.base, self.rules, self.facing = base, rules, facing
@@ -218,11 +220,16 @@ class Centred:
             return None
         xy, yaw = drawn
         for a in req.anchors:
-            rule = None if a.obj is None or a.reverse else self.rules.get((req.room.categories[a.obj], req.category, a.kind))
-            if rule is None:
+            if a.obj is None or a.reverse:
                 continue
-            share = np.asarray(rule) if a.kind == SUPPORT else (
-                np.array([rule[0], 0.0]) if a.direction in ("front", "back") else np.array([0.0, rule[1]]))
+            pair = (req.room.categories[a.obj], req.category)
+            rule, back = self.rules.get((*pair, a.kind)), self.rules.get((*pair, "back")) if a.kind == SUPPORT else None
+            if rule is None and back is None:
+                continue
+            share = np.asarray(rule or (0.0, 0.0)) * (
+                [1, 1] if a.kind == SUPPORT else [1, 0] if a.direction in ("front", "back") else [0, 1])
+            if back is not None and rng.random() < back[0]:
+                xy, share = self._onto_back(req.room.boxes[a.obj], a.target_half, yaw, back[1], xy), share * [1, 0]
             xy = self._onto_line(a.frame, xy, share, rng)
         planned = {a.obj for a in req.anchors}
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
@@ -239,6 +246,15 @@ class Centred:
             return np.zeros(0, int)
         boxes = np.vstack([req.room.boxes.reshape(-1, 7), [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
         return np.flatnonzero(ruled & facing_each_other(boxes, self.facing)[:-1, -1])
+
+    @staticmethod
+    def _onto_back(support: np.ndarray, half, yaw: float, gap: float, xy: np.ndarray) -> np.ndarray:
+        """``xy`` moved along ``support (7,)`` so that a footprint of half extents ``half (2,)`` turned ``yaw`` stands
+        ``gap`` m from the support's back edge (:func:`~pipeline.placement.support.back_gap`)."""
+        frame, turn = box_frame(support), yaw - support[6]
+        local = to_local(frame, xy)
+        local[1] = gap - support[4] + abs(np.sin(turn)) * half[0] + abs(np.cos(turn)) * half[1]
+        return to_world(frame, local)
 
     @staticmethod
     def _onto_line(frame, xy: np.ndarray, share: np.ndarray, rng: np.random.Generator) -> np.ndarray:

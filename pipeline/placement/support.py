@@ -59,16 +59,27 @@ def learn_support_floor(rooms: list[RoomInput], cfg: dict, floor_contact: float)
     return {c: round(f, 3) for c, f in sorted(floor.items()) if f < cfg["min_support"]}
 
 
+def back_gap(support: np.ndarray, obj: np.ndarray) -> float:
+    """m between the back edge of ``support (7,)``'s top (its local -y side) and the nearest point of ``obj (7,)``'s
+    footprint, measured along the support (negative: the object overhangs it)."""
+    turn = obj[6] - support[6]
+    half_y = abs(np.sin(turn)) * obj[3] + abs(np.cos(turn)) * obj[4]
+    return float(support[4] - half_y + to_local(box_frame(support), obj[:2])[1])
+
+
 def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float,
-                   floor_contact: float, facing: float) -> dict[tuple[str, str, str], tuple[float, float]]:
+                   floor_contact: float, facing: float, flush: float = 0.0) -> dict[tuple[str, str, str], tuple[float, float]]:
     """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the shares ``(across, along)`` of
     the training rooms' pairs whose object's centre lies within ``within`` m of the anchor's centre line across it
     (local x = 0) and along it (local y = 0). ``support``: an object and the support it stands on (both lines);
     ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's front or back region,
     along over those in its side regions; ``facing``: two floor objects facing each other within ``facing`` rad
     (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the room), across.
+    ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands within ``flush``
+    m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median gap (m).
     A share needs ``min_pairs`` pairs (else 0); rules whose shares are both 0 are left out."""
     seen: dict[tuple[str, str, str], list[list[bool]]] = {}
+    backs: dict[tuple[str, str, str], list[float]] = {}
     for room in rooms:
         b, cats = room.boxes.reshape(-1, 7), room.categories
         for k, j, _ in support_pairs(room, tolerance, floor_contact):
@@ -76,6 +87,7 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
             lines = seen.setdefault((cats[j], cats[k], "support"), [[], []])
             lines[0].append(bool(u <= within))
             lines[1].append(bool(v <= within))
+            backs.setdefault((cats[j], cats[k], "back"), []).append(back_gap(b[j], b[k]))
         floor = np.flatnonzero(b[:, 2] - b[:, 5] <= floor_contact)
         fb, fcats = b[floor], [cats[k] for k in floor]
         off, region = np.abs(offsets(fb)), regions(fb)  # (a, t, 2) m, (a, t) index into REGIONS
@@ -86,4 +98,7 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
                 seen.setdefault((fcats[a], fcats[t], kind), [[], []])[axis].append(bool(off[a, t, axis] <= within))
     share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
     rules = {key: (round(share(across), 3), round(share(along), 3)) for key, (across, along) in sorted(seen.items())}
-    return {key: r for key, r in rules.items() if r != (0.0, 0.0)}
+    for key, gaps in sorted(backs.items()):
+        near = [g for g in gaps if abs(g) <= flush]
+        rules[key] = (round(share([abs(g) <= flush for g in gaps]), 3), round(float(np.median(near)) if near else 0.0, 3))
+    return {key: r for key, r in rules.items() if r[0] or (r[1] and key[2] != "back")}

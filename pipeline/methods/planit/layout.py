@@ -48,7 +48,7 @@ def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], t
     snap = config["instantiate"]["snap"]
     rules = learn_centring(corpus.training(), snap["centre_within"], snap["centre_min_pairs"],
                            config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
-                           np.radians(snap["centre_facing_angle"]))
+                           np.radians(snap["centre_facing_angle"]), snap["flush_within"])
     if rules:
         log.info("%s: centre-line shares from the training rooms: %s", corpus.room_type,
                  {"/".join(key): v for key, v in rules.items()})
