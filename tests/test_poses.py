@@ -234,6 +234,26 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
         assert abs(to_local(box_frame(desk.boxes[0]), c[:2])[0]) < 1e-9, seed
 
 
+def test_back_gap_reads_flush_overhanging_and_turned_footprints_and_onto_back_inverts_it():
+    desk = np.array([1.0, 2.0, 0.4, 0.6, 0.3, 0.4, 0.0])  # depth along y: back edge at y = 1.7
+    box = lambda x, y, yaw, hx=0.2, hy=0.1: np.array([x, y, 0.9, hx, hy, 0.1, yaw])
+    assert back_gap(desk, box(1.3, 1.8, 0.0)) == pytest.approx(0.0)  # flush: its back face on the edge
+    assert back_gap(desk, box(0.8, 1.85, math.pi)) == pytest.approx(0.05)  # turned round: same depth
+    assert back_gap(desk, box(1.0, 1.9, math.pi / 2)) == pytest.approx(0.0)  # a quarter turn: its width is the depth
+    assert back_gap(desk, box(1.0, 1.75, 0.0)) == pytest.approx(-0.05)  # overhangs the back
+    turned = desk.copy()
+    turned[6] = math.pi / 2  # the back edge now at x = 1.3 (local -y points to +x)
+    assert back_gap(turned, box(1.2, 2.0, math.pi / 2)) == pytest.approx(0.0)
+    assert back_gap(turned, box(1.2, 2.0, 0.0)) == pytest.approx(-0.1)  # its 0.2 m half width overhangs by 0.1
+    rng = np.random.default_rng(0)
+    for support in (desk, turned):
+        for _ in range(20):
+            yaw, xy = rng.uniform(-math.pi, math.pi), support[:2] + rng.uniform(-0.3, 0.3, 2)
+            moved = Centred._onto_back(support, (0.2, 0.1), yaw, 0.016, xy)
+            assert back_gap(support, box(*moved, yaw)) == pytest.approx(0.016)
+            assert to_local(box_frame(support), moved)[0] == pytest.approx(to_local(box_frame(support), xy)[0])
+
+
 def _tv_at_back(room: Room, gap: float) -> Room:
     """``room`` with its TV moved along its stand to stand ``gap`` m from the stand's back edge."""
     inp = room.room_input()

@@ -18,6 +18,7 @@ from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .layout import box_frame, wall_frame
+from .support import half_depth_on
 
 
 @dataclass
@@ -251,9 +252,9 @@ class Centred:
     def _onto_back(support: np.ndarray, half, yaw: float, gap: float, xy: np.ndarray) -> np.ndarray:
         """``xy`` moved along ``support (7,)`` so that a footprint of half extents ``half (2,)`` turned ``yaw`` stands
         ``gap`` m from the support's back edge (:func:`~pipeline.placement.support.back_gap`)."""
-        frame, turn = box_frame(support), yaw - support[6]
+        frame = box_frame(support)
         local = to_local(frame, xy)
-        local[1] = gap - support[4] + abs(np.sin(turn)) * half[0] + abs(np.cos(turn)) * half[1]
+        local[1] = gap - support[4] + half_depth_on(support, half, yaw)
         return to_world(frame, local)
 
     @staticmethod

@@ -59,12 +59,17 @@ def learn_support_floor(rooms: list[RoomInput], cfg: dict, floor_contact: float)
     return {c: round(f, 3) for c, f in sorted(floor.items()) if f < cfg["min_support"]}
 
 
+def half_depth_on(support: np.ndarray, half, yaw: float) -> float:
+    """m: half the extent along ``support (7,)``'s depth (its local y) of a footprint of half extents ``half (2,)``
+    turned ``yaw``."""
+    turn = yaw - support[6]
+    return float(abs(np.sin(turn)) * half[0] + abs(np.cos(turn)) * half[1])
+
+
 def back_gap(support: np.ndarray, obj: np.ndarray) -> float:
     """m between the back edge of ``support (7,)``'s top (its local -y side) and the nearest point of ``obj (7,)``'s
     footprint, measured along the support (negative: the object overhangs it)."""
-    turn = obj[6] - support[6]
-    half_y = abs(np.sin(turn)) * obj[3] + abs(np.cos(turn)) * obj[4]
-    return float(support[4] - half_y + to_local(box_frame(support), obj[:2])[1])
+    return float(support[4] - half_depth_on(support, obj[3:5], obj[6]) + to_local(box_frame(support), obj[:2])[1])
 
 
 def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float,
@@ -99,6 +104,7 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
     share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
     rules = {key: (round(share(across), 3), round(share(along), 3)) for key, (across, along) in sorted(seen.items())}
     for key, gaps in sorted(backs.items()):
-        near = [g for g in gaps if abs(g) <= flush]
-        rules[key] = (round(share([abs(g) <= flush for g in gaps]), 3), round(float(np.median(near)) if near else 0.0, 3))
-    return {key: r for key, r in rules.items() if r[0] or (r[1] and key[2] != "back")}
+        flush_share = share([abs(g) <= flush for g in gaps])
+        if flush_share:
+            rules[key] = (round(flush_share, 3), round(float(np.median([g for g in gaps if abs(g) <= flush])), 3))
+    return {key: r for key, r in rules.items() if r != (0.0, 0.0)}
