@@ -18,7 +18,7 @@ from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .layout import box_frame, wall_frame
-from .support import half_depth_on
+from .support import CentreLine, half_depth_on
 
 
 @dataclass
@@ -200,11 +200,13 @@ class Masked(DensityProposer):
 
 
 class Centred:
-    """A proposer whose objects stand on their anchors' centre lines as often as the training rooms' do: ``rules``
-    maps (anchor category, object category, ``support`` | ``spatial`` | ``facing``) to the shares ``(across, along)``
-    of :func:`~pipeline.placement.support.learn_centring`. On a support, with the ``back`` rule's share the drawn place
+    """A proposer whose objects stand near their anchors' centre lines as often and as far off them as the training
+    rooms' do: ``rules`` maps (anchor category, object category, ``support`` | ``spatial`` | ``facing``) to the
+    :class:`~pipeline.placement.support.CentreLine` of :func:`~pipeline.placement.support.learn_centring` (a plain
+    ``(across, along)`` pair of shares: offsets 0). On a support, with the ``back`` rule's share the drawn place
     moves along the support to stand the rule's gap from its back edge (a monitor at the back of its desk), else
-    with each share's probability the drawn place's offset across (along) the support is set to 0; beside a placed
+    with each share's probability the drawn place's offset across (along) the support is replaced by one of the
+    training pairs' offsets near the line, drawn uniformly; beside a placed
     floor anchor planned in front of or behind it, the offset across it, and planned left or right of it, the offset
     along it; a floor object facing a placed object with no planned edge to it, the two facing each other within
     ``facing`` rad at the drawn pose (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it.
@@ -212,7 +214,7 @@ class Centred:
     preset); the turn is the base proposer's.
     """
 
-    def __init__(self, base, rules: dict[tuple[str, str, str], tuple[float, float]], facing: float = np.pi / 4):
+    def __init__(self, base, rules: dict[tuple[str, str, str], tuple], facing: float = np.pi / 4):
         self.base, self.rules, self.facing = base, rules, facing
 
     def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
@@ -227,16 +229,17 @@ class Centred:
             rule, back = self.rules.get((*pair, a.kind)), self.rules.get((*pair, "back")) if a.kind == SUPPORT else None
             if rule is None and back is None:
                 continue
-            share = np.asarray(rule or (0.0, 0.0)) * (
+            line = CentreLine(*(rule or (0.0, 0.0)))
+            share = np.asarray(line[:2]) * (
                 [1, 1] if a.kind == SUPPORT else [1, 0] if a.direction in ("front", "back") else [0, 1])
             if back is not None and rng.random() < back[0]:
                 xy, share = self._onto_back(req.room.boxes[a.obj], a.target_half, yaw, back[1], xy), share * [1, 0]
-            xy = self._onto_line(a.frame, xy, share, rng)
+            xy = self._onto_line(a.frame, xy, share, line, rng)
         planned = {a.obj for a in req.anchors}
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
             if o not in planned:
-                share = np.array([self.rules[(req.room.categories[o], req.category, "facing")][0], 0.0])
-                xy = self._onto_line(box_frame(req.room.boxes[o]), xy, share, rng)
+                line = CentreLine(*self.rules[(req.room.categories[o], req.category, "facing")])
+                xy = self._onto_line(box_frame(req.room.boxes[o]), xy, np.array([line.across, 0.0]), line, rng)
         return xy, yaw
 
     def _facing(self, req: Request, xy: np.ndarray, yaw: float) -> np.ndarray:
@@ -258,8 +261,12 @@ class Centred:
         return to_world(frame, local)
 
     @staticmethod
-    def _onto_line(frame, xy: np.ndarray, share: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        """``xy`` with its offset across (along) ``frame``'s centre line set to 0 with probability ``share (2,)``."""
+    def _onto_line(frame, xy: np.ndarray, share: np.ndarray, line: CentreLine, rng: np.random.Generator) -> np.ndarray:
+        """``xy`` with its offset across (along) ``frame``'s centre line replaced, with probability ``share (2,)``, by
+        one of ``line``'s training offsets across (along) it."""
         local = to_local(frame, xy)
-        local[rng.random(2) < share] = 0.0
+        hit = rng.random(2) < share
+        for axis, offs in enumerate((line.across_offsets, line.along_offsets)):
+            if hit[axis]:
+                local[axis] = offs[rng.integers(len(offs))]
         return to_world(frame, local)

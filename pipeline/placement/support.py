@@ -9,10 +9,13 @@ A training object's support is geometric: the object whose box top lies within `
 whose footprint holds the most of it; the share is the check's own :func:`~pipeline.placement.checks.support_share`.
 
 Where on its support an object stands, learned the same way (:func:`learn_centring`): per (support category, object
-category), the share of the training pairs whose object stands on the support's centre line across it (local x) and
-along it (local y); the search's proposers draw a place at the resolution of their grid or network (PlanIT's location
-network: 0.15 m per pixel at the default preset), finer than which a television is not centred on its stand."""
+category), the share of the training pairs whose object stands near the support's centre line across it (local x)
+and along it (local y), and their offsets from it; the search's proposers draw a place at the resolution of their
+grid or network (PlanIT's location network: 0.15 m per pixel at the default preset), coarser than the centimetres by
+which a television stands off its stand's middle or an office chair off its desk's."""
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 
@@ -23,6 +26,17 @@ from .checks import support_share
 from .layout import box_frame
 
 FRONT, BACK, SIDE_FRONT, SIDE_BACK = (REGIONS.index(r) for r in ("front", "back", "side_front", "side_back"))
+
+
+class CentreLine(NamedTuple):
+    """Where the training pairs of one (anchor category, object category, kind) stand about the anchor's centre
+    lines: the shares ``across`` and ``along`` of the pairs whose object's centre lies within ``within`` m of the line
+    (local x = 0, local y = 0), and those pairs' signed offsets (m), which the search draws from (0: on the line)."""
+
+    across: float
+    along: float
+    across_offsets: tuple[float, ...] = (0.0,)
+    along_offsets: tuple[float, ...] = (0.0,)
 
 
 def support_pairs(room: RoomInput, tolerance: float, floor_contact: float) -> list[tuple[int, int, float]]:
@@ -72,39 +86,60 @@ def back_gap(support: np.ndarray, obj: np.ndarray) -> float:
     return float(support[4] - half_depth_on(support, obj[3:5], obj[6]) + to_local(box_frame(support), obj[:2])[1])
 
 
-def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float,
-                   floor_contact: float, facing: float, flush: float = 0.0) -> dict[tuple[str, str, str], tuple[float, float]]:
-    """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the shares ``(across, along)`` of
-    the training rooms' pairs whose object's centre lies within ``within`` m of the anchor's centre line across it
-    (local x = 0) and along it (local y = 0). ``support``: an object and the support it stands on (both lines);
-    ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's front or back region,
-    along over those in its side regions; ``facing``: two floor objects facing each other within ``facing`` rad
-    (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the room), across.
-    ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands within ``flush``
-    m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median gap (m).
-    A share needs ``min_pairs`` pairs (else 0); rules whose shares are both 0 are left out."""
-    seen: dict[tuple[str, str, str], list[list[bool]]] = {}
+def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float, floor_contact: float,
+                   facing: float, flush: float = 0.0, concentration: float = 0.0) -> dict[tuple[str, str, str], tuple]:
+    """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the :class:`CentreLine` of the
+    training rooms' pairs: the shares whose object's centre lies within ``within`` m of the anchor's centre line across
+    it (local x = 0) and along it (local y = 0), with those pairs' offsets. ``support``: an object and the support it
+    stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
+    front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
+    ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
+    room), across. ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands
+    within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median
+    gap (m). A share needs ``min_pairs`` pairs and ``concentration`` times the share the same pairs would show spread
+    evenly over the anchor (``within`` over its half extent on that axis, at most 1), else it is 0: plants stand
+    within 10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
+    seen: dict[tuple[str, str, str], tuple[list[tuple[float, float]], list[tuple[float, float]]]] = {}
     backs: dict[tuple[str, str, str], list[float]] = {}
     for room in rooms:
         b, cats = room.boxes.reshape(-1, 7), room.categories
         for k, j, _ in support_pairs(room, tolerance, floor_contact):
-            u, v = np.abs(to_local(box_frame(b[j]), b[k, :2]))
-            lines = seen.setdefault((cats[j], cats[k], "support"), [[], []])
-            lines[0].append(bool(u <= within))
-            lines[1].append(bool(v <= within))
+            u, v = to_local(box_frame(b[j]), b[k, :2])
+            lines = seen.setdefault((cats[j], cats[k], "support"), ([], []))
+            lines[0].append((float(u), float(b[j, 3])))
+            lines[1].append((float(v), float(b[j, 4])))
             backs.setdefault((cats[j], cats[k], "back"), []).append(back_gap(b[j], b[k]))
         floor = np.flatnonzero(b[:, 2] - b[:, 5] <= floor_contact)
         fb, fcats = b[floor], [cats[k] for k in floor]
-        off, region = np.abs(offsets(fb)), regions(fb)  # (a, t, 2) m, (a, t) index into REGIONS
+        off, region = offsets(fb), regions(fb)  # (a, t, 2) m, (a, t) index into REGIONS
         lined = ((np.isin(region, (FRONT, BACK)), "spatial", 0), (np.isin(region, (SIDE_FRONT, SIDE_BACK)), "spatial", 1),
                  (facing_each_other(fb, facing), "facing", 0))
         for pairs, kind, axis in lined:
             for a, t in zip(*np.nonzero(pairs)):
-                seen.setdefault((fcats[a], fcats[t], kind), [[], []])[axis].append(bool(off[a, t, axis] <= within))
+                seen.setdefault((fcats[a], fcats[t], kind), ([], []))[axis].append((float(off[a, t, axis]),
+                                                                                    float(fb[a, 3 + axis])))
+    rules: dict[tuple[str, str, str], tuple] = {}
+    for key, axes in sorted(seen.items()):
+        found = [_near_line(np.array(pairs).reshape(-1, 2), within, min_pairs, concentration) for pairs in axes]
+        if any(share for share, _ in found):
+            rules[key] = CentreLine(found[0][0], found[1][0], found[0][1], found[1][1])
     share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
-    rules = {key: (round(share(across), 3), round(share(along), 3)) for key, (across, along) in sorted(seen.items())}
     for key, gaps in sorted(backs.items()):
         flush_share = share([abs(g) <= flush for g in gaps])
         if flush_share:
             rules[key] = (round(flush_share, 3), round(float(np.median([g for g in gaps if abs(g) <= flush])), 3))
-    return {key: r for key, r in rules.items() if r != (0.0, 0.0)}
+    return rules
+
+
+def _near_line(pairs: np.ndarray, within: float, min_pairs: int, concentration: float) -> tuple[float, tuple[float, ...]]:
+    """The share of ``pairs (n, 2)`` (offset from the anchor's centre line, the anchor's half extent on that axis; m)
+    within ``within`` of the line and their offsets (rounded to mm); ``(0, (0,))`` with fewer than ``min_pairs`` pairs
+    or a share under ``concentration`` times the share an even spread over the anchor gives."""
+    near = np.abs(pairs[:, 0]) <= within
+    if len(pairs) < min_pairs or not near.any():
+        return 0.0, (0.0,)
+    chance = float(np.mean(np.minimum(1.0, within / np.maximum(pairs[:, 1], 1e-9))))
+    share = float(near.mean())
+    if share < concentration * chance:
+        return 0.0, (0.0,)
+    return round(share, 3), tuple(float(o) for o in np.round(pairs[near, 0], 3))

@@ -42,16 +42,16 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, centring: dict
     return proposers.Centred(base, centring, np.radians(cfg["snap"]["centre_facing_angle"]))
 
 
-def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], tuple[float, float]]:
+def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], tuple]:
     """The training rooms' centre-line shares of objects on supports, beside floor anchors and facing each other
     (:func:`~pipeline.placement.support.learn_centring`, ``instantiate.snap``'s settings)."""
     snap = config["instantiate"]["snap"]
     rules = learn_centring(corpus.training(), snap["centre_within"], snap["centre_min_pairs"],
                            config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
-                           np.radians(snap["centre_facing_angle"]), snap["flush_within"])
+                           np.radians(snap["centre_facing_angle"]), snap["flush_within"], snap["centre_concentration"])
     if rules:
         log.info("%s: centre-line shares from the training rooms: %s", corpus.room_type,
-                 {"/".join(key): v for key, v in rules.items()})
+                 {"/".join(key): tuple(v[:2]) for key, v in rules.items()})
     return rules
 
 
