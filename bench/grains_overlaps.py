@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from instantiate import corpus_of
 
 from pipeline import config as config_mod
 from pipeline.geometry.boxes import penetration_depths
@@ -30,6 +29,7 @@ from pipeline.placement.retrieval import nearest, nearest_within
 from pipeline.seeding import seed_of
 
 from common import ROOT, arguments, report
+from instantiate import corpus_of
 
 
 def retrieved(boxes: np.ndarray, placed: list, on: dict[int, int], pool, pick) -> np.ndarray:

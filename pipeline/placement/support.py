@@ -86,19 +86,14 @@ def back_gap(support: np.ndarray, obj: np.ndarray) -> float:
     return float(support[4] - half_depth_on(support, obj[3:5], obj[6]) + to_local(box_frame(support), obj[:2])[1])
 
 
-def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float, floor_contact: float,
-                   facing: float, flush: float = 0.0, concentration: float = 0.0) -> dict[tuple[str, str, str], tuple]:
-    """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the :class:`CentreLine` of the
-    training rooms' pairs: the shares whose object's centre lies within ``within`` m of the anchor's centre line across
-    it (local x = 0) and along it (local y = 0), with those pairs' offsets. ``support``: an object and the support it
-    stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
-    front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
-    ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
-    room), across. ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands
-    within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median
-    gap (m). A share needs ``min_pairs`` pairs and ``concentration`` times the share the same pairs would show spread
-    evenly over the anchor (``within`` over its half extent on that axis, at most 1), else it is 0: plants stand
-    within 10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
+Key = tuple[str, str, str]
+
+
+def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: float,
+                   facing: float) -> tuple[dict[Key, tuple[np.ndarray, np.ndarray]], dict[Key, list[float]]]:
+    """The pairs :func:`learn_centring` reads: (anchor category, object category, kind) -> ``(across (n, 2), along
+    (m, 2))``, each row an object's signed offset from the anchor's centre line and the anchor's half extent on that
+    axis (m); and (support category, object category, ``back``) -> the pairs' :func:`back_gap` (m)."""
     seen: dict[tuple[str, str, str], tuple[list[tuple[float, float]], list[tuple[float, float]]]] = {}
     backs: dict[tuple[str, str, str], list[float]] = {}
     for room in rooms:
@@ -118,9 +113,27 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
             for a, t in zip(*np.nonzero(pairs)):
                 seen.setdefault((fcats[a], fcats[t], kind), ([], []))[axis].append((float(off[a, t, axis]),
                                                                                     float(fb[a, 3 + axis])))
+    pairs = lambda rows: np.array(rows, float).reshape(-1, 2)
+    return {key: (pairs(across), pairs(along)) for key, (across, along) in seen.items()}, backs
+
+
+def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float, floor_contact: float,
+                   facing: float, flush: float = 0.0, concentration: float = 0.0) -> dict[tuple[str, str, str], tuple]:
+    """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the :class:`CentreLine` of the
+    training rooms' pairs: the shares whose object's centre lies within ``within`` m of the anchor's centre line across
+    it (local x = 0) and along it (local y = 0), with those pairs' offsets. ``support``: an object and the support it
+    stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
+    front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
+    ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
+    room), across. ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands
+    within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median
+    gap (m). A share needs ``min_pairs`` pairs and ``concentration`` times the share the same pairs would show spread
+    evenly over the anchor (``within`` over its half extent on that axis, at most 1), else it is 0: plants stand
+    within 10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
+    seen, backs = centre_offsets(rooms, tolerance, floor_contact, facing)
     rules: dict[tuple[str, str, str], tuple] = {}
     for key, axes in sorted(seen.items()):
-        found = [_near_line(np.array(pairs).reshape(-1, 2), within, min_pairs, concentration) for pairs in axes]
+        found = [_near_line(pairs, within, min_pairs, concentration) for pairs in axes]
         if any(share for share, _ in found):
             rules[key] = CentreLine(found[0][0], found[1][0], found[0][1], found[1][1])
     share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
