@@ -17,7 +17,7 @@ import numpy as np
 
 from pipeline import config as config_mod
 from pipeline.evaluation.sets import load_generated
-from pipeline.methods.planit.layout import centring_rules
+from pipeline.methods.planit.layout import pose_rules
 from pipeline.placement.support import centre_offsets
 
 from common import ROOT, arguments, report
@@ -48,7 +48,7 @@ def main() -> None:
     args = ap.parse_args()
     cfg = config_mod.load(args.config)
     corpus = corpus_of(cfg, args.room_type)
-    rules = centring_rules(cfg, corpus)
+    rules = pose_rules(cfg, corpus).centring
     sets = {"real_heldout": corpus.heldout()}
     for m in args.methods:
         g = (args.generated or Path("results/generated") / args.room_type) / m

@@ -143,7 +143,7 @@ def main() -> None:
     plans = instantiate.select_plans(cfg, variant, ctx.corpus, graphs / "nodes.parquet", graphs / "edges.parquet",
                                      args.scenes * draws)
     proposer = instantiate.make_proposer(args.location, saved, cfg["instantiate"], cfg["extract"],
-                                         instantiate.centring_rules(cfg, ctx.corpus))
+                                         instantiate.pose_rules(cfg, ctx.corpus))
     rows, rooms, colliding, ev = [], [], 0, {**cfg["evaluate"]["collision"], "intersector": ctx.checker.intersector}
     fn_cfg, sym = cfg["evaluate"]["functional"], ctx.checker.symmetry
     learned, functional = functional_checks.learn_checks(ctx.corpus.training(), fn_cfg, sym), []

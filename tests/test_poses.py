@@ -18,10 +18,11 @@ from pipeline.geometry.raycast import intersector_class
 from pipeline.placement.checks import Checker
 from pipeline.placement.layout import add_object, box_frame, wall_frame, walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
-from pipeline.placement.proposers import Centred, Combined, FaceAway, RelationPrior, UniformLocation
+from pipeline.placement.proposers import BackToWall, Centred, Combined, FaceAway, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import instantiate
 from pipeline.placement.support import CentreLine, back_gap, learn_centring
+from pipeline.placement.walls import learn_wall_backs
 
 from conftest import Room, default_config
 
@@ -271,6 +272,50 @@ def test_objects_stand_as_far_off_their_anchors_centre_lines_as_in_the_training_
     across = [round(float(to_local(box_frame(desk.boxes[0]), placed(instantiate(
         plan, desk, walls, [0], chair, pool, checker, cfg["instantiate"], seed), "c")[:2])[0]), 6) for seed in SEEDS]
     assert set(across) == {-0.05, 0.04}, across
+
+
+class Sideways:
+    """Front turned a quarter turn from "away from the first anchor" (a wall): a desk with its side to that wall."""
+
+    def orientation(self, req, xy, rng) -> float:
+        return req.anchors[0].frame.yaw + math.pi / 2
+
+
+def _desk_sideways(room: Room) -> Room:
+    """``room`` with its desk turned a quarter turn, its side against the bottom wall (its chair moved off)."""
+    for o in room.objects:
+        if o["category"] == "desk":
+            o["yaw"] = o["yaw"] + 90.0
+        if o["category"] == "chair":
+            o["cx"], o["cy"], o["px"], o["py"] = o["cx"], o["cy"] + 0.6, o["px"], o["py"] + 0.6
+    return room
+
+
+def test_objects_planned_against_a_wall_turn_their_back_to_it_as_often_as_in_the_training_rooms():
+    # learned: the hand-built rooms' desks, beds, nightstands and TV stands all stand with their backs to the wall
+    # they stand against; desks turned with their side to it give no desk rule; too few rooms give none
+    cfg = default_config()
+    learn = lambda rooms: learn_wall_backs(rooms, 0.1, math.radians(15), 10, cfg["floor_contact"])
+    shares = learn([furnished(s).room_input() for s in range(12)])
+    assert shares == {"bed": 1.0, "desk": 1.0, "nightstand": 1.0, "tv_stand": 1.0}, shares
+    turned = [_desk_sideways(furnished(s)).room_input() for s in range(12)]
+    assert all(not back_to_wall(r.boxes.reshape(-1, 7)[[r.object_ids.index("desk")]], r.outline, 0.1, math.radians(15))[0]
+               for r in turned)
+    assert "desk" not in learn(turned) and learn(turned)["bed"] == 1.0
+    assert learn([furnished(s).room_input() for s in range(4)]) == {}  # 8 nightstands, 4 of the rest
+    # applied: a desk planned against the right wall, drawn with its side to the nearest wall, stands sideways; with
+    # the rule its back is to the planned wall (the search's snap slides it flush)
+    room, walls, pool, checker, cfg = setup_room(furnished(0))
+    plan = plan_of("d", "desk", [PlanEdge(walls.ids[1], "d", "spatial", "front", "adjacent")])
+    drawn = Combined(RelationPrior(cfg["extract"]), Sideways())
+    desk = lambda proposer, seed: placed(instantiate(plan, room, walls, [0], proposer, pool, checker,
+                                                     cfg["instantiate"], seed), "d")
+    assert all(turn_error(desk(drawn, seed)[6] - wall_frame(walls, 1).yaw) > 1.5 for seed in SEEDS)
+    backed = BackToWall(drawn, {"desk": 1.0})
+    for seed in SEEDS:
+        d = desk(backed, seed)
+        assert turn_error(d[6] - wall_frame(walls, 1).yaw) <= 1e-9, (seed, d)
+        assert back_to_wall(d[None], room.outline, 0.1, math.radians(15))[0], (seed, d)
 
 
 def test_back_gap_reads_flush_overhanging_and_turned_footprints_and_onto_back_inverts_it():

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d
-from ..geometry.frames import to_local, to_world
+from ..geometry.frames import to_local, to_world, turn_error
 from ..geometry.function import facing_each_other
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
@@ -170,6 +170,27 @@ class FaceAway:
 
     def orientation(self, req: Request, xy: np.ndarray, rng: np.random.Generator) -> float:
         return wall_frame(req.walls, nearest_wall(req.walls, xy)).yaw
+
+
+class BackToWall:
+    """A proposer whose objects planned adjacent to a wall stand with their back to one of those walls as often as the
+    training rooms' objects of their category do against a wall (``shares``:
+    :func:`~pipeline.placement.walls.learn_wall_backs`): with that share the drawn turn becomes the nearest of the
+    planned walls' "facing into the room" turns; the place stays drawn (the search's snap then slides the object
+    flush against the wall)."""
+
+    def __init__(self, base, shares: dict[str, float]):
+        self.base, self.shares = base, shares
+
+    def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        drawn = self.base.pose(req, rng)
+        share = self.shares.get(req.category, 0.0)
+        walls = [a.wall for a in req.anchors if a.wall is not None and a.distance == "adjacent" and not a.reverse]
+        if drawn is None or not walls or not share or rng.random() >= share:
+            return drawn
+        xy, yaw = drawn
+        away = np.array([wall_frame(req.walls, w).yaw for w in walls])
+        return xy, float(away[np.argmin(turn_error(away - yaw))])
 
 
 class Combined(DensityProposer):

@@ -113,8 +113,8 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
             for a, t in zip(*np.nonzero(pairs)):
                 seen.setdefault((fcats[a], fcats[t], kind), ([], []))[axis].append((float(off[a, t, axis]),
                                                                                     float(fb[a, 3 + axis])))
-    pairs = lambda rows: np.array(rows, float).reshape(-1, 2)
-    return {key: (pairs(across), pairs(along)) for key, (across, along) in seen.items()}, backs
+    as_rows = lambda rows: np.array(rows, float).reshape(-1, 2)
+    return {key: (as_rows(across), as_rows(along)) for key, (across, along) in seen.items()}, backs
 
 
 def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float, floor_contact: float,

@@ -4,7 +4,7 @@ baselines) or per Table 3 ablation (held-out rooms' own graphs)."""
 from __future__ import annotations
 
 import logging
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Iterator
 
@@ -21,6 +21,7 @@ from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from ...placement.search import SCORED, instantiate
 from ...placement.support import learn_centring
+from ...placement.walls import learn_wall_backs
 from ...seeding import seed_of
 from ..interface import Corpus, Scene, Task
 from ..placing import Context, load_context, scene_of
@@ -30,29 +31,45 @@ from .nets.train import KIND
 log = logging.getLogger("planit.instantiate")
 
 
-def make_proposer(location: str, saved, cfg: dict, extract: dict, centring: dict | None = None):
+@dataclass(frozen=True)
+class PoseRules:
+    """What the training rooms say about poses beyond the proposer's draw: centre-line and back-edge rules per
+    (anchor, object, kind) (:func:`~pipeline.placement.support.learn_centring`) and per category the share of
+    objects against a wall that have their back to it (:func:`~pipeline.placement.walls.learn_wall_backs`)."""
+    centring: dict = field(default_factory=dict)
+    wall_backs: dict = field(default_factory=dict)
+
+
+def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRules | None = None):
     """The variant's proposer (``cfg``: its instantiate settings, ``extract``: the extraction's): the pose networks
     (their densities weighted by the relation bands when ``relation_mask``), the relative-pose prior (likewise), or
-    uniform or rule-band locations with the networks' orientations; objects put on the centre lines of their supports,
-    planned floor anchors and the placed objects they face by the training rooms' ``centring`` shares when the variant
-    snaps (:class:`~pipeline.placement.proposers.Centred`)."""
+    uniform or rule-band locations with the networks' orientations; when the variant snaps, objects planned against a
+    wall turned with their back to it (:class:`~pipeline.placement.proposers.BackToWall`) and put on the centre lines
+    of their supports, planned floor anchors and the placed objects they face
+    (:class:`~pipeline.placement.proposers.Centred`) by the training rooms' ``rules``."""
     base = location_proposer(location, saved, cfg, extract)
-    if not centring or not cfg["snap"]["enabled"]:
+    if rules is None or not cfg["snap"]["enabled"]:
         return base
-    return proposers.Centred(base, centring, np.radians(cfg["snap"]["centre_facing_angle"]))
+    if rules.wall_backs:
+        base = proposers.BackToWall(base, rules.wall_backs)
+    if rules.centring:
+        base = proposers.Centred(base, rules.centring, np.radians(cfg["snap"]["centre_facing_angle"]))
+    return base
 
 
-def centring_rules(config: dict, corpus: Corpus) -> dict[tuple[str, str, str], tuple]:
-    """The training rooms' centre-line shares of objects on supports, beside floor anchors and facing each other
-    (:func:`~pipeline.placement.support.learn_centring`, ``instantiate.snap``'s settings)."""
+def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
+    """The training rooms' pose rules (``instantiate.snap``'s settings): centre lines and back edges of objects on
+    supports, beside floor anchors and facing each other, and backs to walls."""
     snap = config["instantiate"]["snap"]
-    rules = learn_centring(corpus.training(), snap["centre_within"], snap["centre_min_pairs"],
-                           config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
-                           np.radians(snap["centre_facing_angle"]), snap["flush_within"], snap["centre_concentration"])
-    if rules:
-        log.info("%s: centre-line shares from the training rooms: %s", corpus.room_type,
-                 {"/".join(key): tuple(v[:2]) for key, v in rules.items()})
-    return rules
+    training = corpus.training()
+    centring = learn_centring(training, snap["centre_within"], snap["centre_min_pairs"],
+                              config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
+                              np.radians(snap["centre_facing_angle"]), snap["flush_within"], snap["centre_concentration"])
+    wall_backs = learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
+                                  snap["centre_min_pairs"], config["floor_contact"])
+    log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s",
+             corpus.room_type, {"/".join(key): tuple(v[:2]) for key, v in centring.items()}, wall_backs)
+    return PoseRules(centring, wall_backs)
 
 
 def location_proposer(location: str, saved, cfg: dict, extract: dict):
@@ -135,7 +152,7 @@ class PlanitLayout:
             log.warning("%s: no graph of room type '%s' to place: writing empty tables", task.graphs[0],
                         task.corpus.room_type)
         proposer = make_proposer(self.variant["location"], saved, self.settings, self.config["extract"],
-                                 centring_rules(self.config, task.corpus))
+                                 pose_rules(self.config, task.corpus))
         scored, bar = 0, iter(progress(range(count), desc=f"instantiate {task.corpus.room_type} ({self.name})"))
         for plan in plans:
             if scored >= count:
@@ -169,7 +186,7 @@ class CompleteRoom:
         saved = checkpoint.load(task.model, KIND)
         ctx = load_context(self.config, task.corpus)
         proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"],
-                                 centring_rules(self.config, task.corpus))
+                                 pose_rules(self.config, task.corpus))
         seed = seed_of(self.config["seed"], "complete", plan.scene_id)
         outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)
         yield scene_of(plan, ctx, outcome, walls)

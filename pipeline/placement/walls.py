@@ -1,0 +1,30 @@
+"""Which objects stand with their back to the wall they stand against, learned from the training rooms: a desk in a
+room's corner stands against two walls, its back to one and its side to the other, so a plan's "adjacent to this
+wall" edge does not say which way the desk turns, and a location network or a relative-pose density drawn near a
+corner turns it either way. Per category, the share of the training rooms' floor objects standing square against a
+wall (some side within ``gap`` m of it, turned within ``angle`` rad) whose back is the side against a wall, by the
+evaluation's own predicate (:func:`~pipeline.geometry.function.back_to_wall`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry.function import back_to_wall
+from ..room import RoomInput
+
+
+def learn_wall_backs(rooms: list[RoomInput], gap: float, angle: float, min_pairs: int,
+                     floor_contact: float) -> dict[str, float]:
+    """category -> the share of its training floor objects against a wall that have their back to a wall (only
+    categories with at least ``min_pairs`` such objects and a positive share)."""
+    against: dict[str, list[bool]] = {}
+    for room in rooms:
+        b = room.boxes.reshape(-1, 7)
+        floor = np.flatnonzero(b[:, 2] - b[:, 5] <= floor_contact)
+        if not len(floor):
+            continue
+        near = back_to_wall(b[floor], room.outline, gap, angle, ["rotational-4"] * len(floor))  # any side
+        back = back_to_wall(b[floor], room.outline, gap, angle)
+        for k in np.flatnonzero(near):
+            against.setdefault(room.categories[floor[k]], []).append(bool(back[k]))
+    shares = {c: round(float(np.mean(flags)), 3) for c, flags in sorted(against.items()) if len(flags) >= min_pairs}
+    return {c: s for c, s in shares.items() if s > 0}
