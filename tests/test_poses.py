@@ -235,17 +235,21 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
         assert abs(to_local(box_frame(desk.boxes[0]), c[:2])[0]) < 1e-9, seed
 
 
+def _shifted(room: Room, category: str, d) -> Room:
+    """``room`` with its objects of ``category`` moved by ``d (2,)`` m."""
+    for o in room.objects:
+        if o["category"] == category:
+            o["cx"], o["cy"], o["px"], o["py"] = o["cx"] + d[0], o["cy"] + d[1], o["px"] + d[0], o["py"] + d[1]
+    return room
+
+
 def _chair_across(room: Room, across: float) -> Room:
     """``room`` with its chair moved ``across`` m along its desk's local x (off the desk's centre line)."""
     inp = room.room_input()
     b = inp.boxes.reshape(-1, 7)
     desk, chair = b[inp.object_ids.index("desk")], b[inp.object_ids.index("chair")]
-    local = to_local(box_frame(desk), chair[:2])
-    d = to_world(box_frame(desk), local + [across, 0.0]) - chair[:2]
-    for o in room.objects:
-        if o["category"] == "chair":
-            o["cx"], o["cy"], o["px"], o["py"] = o["cx"] + d[0], o["cy"] + d[1], o["px"] + d[0], o["py"] + d[1]
-    return room
+    return _shifted(room, "chair", to_world(box_frame(desk), to_local(box_frame(desk), chair[:2]) + [across, 0.0])
+                    - chair[:2])
 
 
 def test_objects_stand_as_far_off_their_anchors_centre_lines_as_in_the_training_rooms_where_that_is_concentrated():
@@ -282,13 +286,12 @@ class Sideways:
 
 
 def _desk_sideways(room: Room) -> Room:
-    """``room`` with its desk turned a quarter turn, its side against the bottom wall (its chair moved off)."""
+    """``room`` with its desk turned a quarter turn, its side flush against the wall its back was against."""
+    desk = room.room_input().boxes.reshape(-1, 7)[room.room_input().object_ids.index("desk")]
     for o in room.objects:
         if o["category"] == "desk":
-            o["yaw"] = o["yaw"] + 90.0
-        if o["category"] == "chair":
-            o["cx"], o["cy"], o["px"], o["py"] = o["cx"], o["cy"] + 0.6, o["px"], o["py"] + 0.6
-    return room
+            o["yaw"] = o["yaw"] + math.pi / 2
+    return _shifted(room, "desk", (desk[3] - desk[4]) * np.array([-math.sin(desk[6]), math.cos(desk[6])]))
 
 
 def test_objects_planned_against_a_wall_turn_their_back_to_it_as_often_as_in_the_training_rooms():
@@ -299,8 +302,9 @@ def test_objects_planned_against_a_wall_turn_their_back_to_it_as_often_as_in_the
     shares = learn([furnished(s).room_input() for s in range(12)])
     assert shares == {"bed": 1.0, "desk": 1.0, "nightstand": 1.0, "tv_stand": 1.0}, shares
     turned = [_desk_sideways(furnished(s)).room_input() for s in range(12)]
-    assert all(not back_to_wall(r.boxes.reshape(-1, 7)[[r.object_ids.index("desk")]], r.outline, 0.1, math.radians(15))[0]
-               for r in turned)
+    desks = [(r.boxes.reshape(-1, 7)[[r.object_ids.index("desk")]], r.outline) for r in turned]
+    assert all(back_to_wall(d, o, 0.1, math.radians(15), ["rotational-4"])[0] for d, o in desks)  # against a wall
+    assert not any(back_to_wall(d, o, 0.1, math.radians(15))[0] for d, o in desks)  # by its side
     assert "desk" not in learn(turned) and learn(turned)["bed"] == 1.0
     assert learn([furnished(s).room_input() for s in range(4)]) == {}  # 8 nightstands, 4 of the rest
     # applied: a desk planned against the right wall, drawn with its side to the nearest wall, stands sideways; with
@@ -343,11 +347,7 @@ def _tv_at_back(room: Room, gap: float) -> Room:
     inp = room.room_input()
     b = inp.boxes.reshape(-1, 7)
     stand, tv = b[inp.object_ids.index("stand")], b[inp.object_ids.index("tv")]
-    d = (back_gap(stand, tv) - gap) * np.array([math.sin(stand[6]), -math.cos(stand[6])])  # towards the back
-    for o in room.objects:
-        if o["category"] == "tv":
-            o["cx"], o["cy"], o["px"], o["py"] = o["cx"] + d[0], o["cy"] + d[1], o["px"] + d[0], o["py"] + d[1]
-    return room
+    return _shifted(room, "tv", (back_gap(stand, tv) - gap) * np.array([math.sin(stand[6]), -math.cos(stand[6])]))
 
 
 def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_rooms():
