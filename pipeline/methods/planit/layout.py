@@ -66,7 +66,7 @@ def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
                               config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
                               np.radians(snap["centre_facing_angle"]), snap["flush_within"], snap["centre_concentration"])
     wall_backs = learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
-                                  snap["centre_min_pairs"], config["floor_contact"])
+                                  snap["centre_min_pairs"], config["floor_contact"]) if snap["wall_back_gap"] > 0 else {}
     log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s",
              corpus.room_type, {"/".join(key): tuple(v[:2]) for key, v in centring.items()}, wall_backs)
     return PoseRules(centring, wall_backs)
