@@ -264,6 +264,9 @@ def test_objects_stand_as_far_off_their_anchors_centre_lines_as_in_the_training_
     line = learn(near, 0.1, 3.0)[("desk", "chair", "spatial")]
     assert line.across == 1.0 and sorted(line.across_offsets) == pytest.approx(sorted(jitter), abs=1e-3)
     assert learn(near, 0.02, 0.0)[("desk", "chair", "spatial")].across == round(float(np.mean(abs(jitter) <= 0.02)), 3) < 0.5
+    # the window is also at most a fraction of the anchor's half extent (0.05 of the desk's 0.6 m: 3 cm)
+    small = learn_centring(near, 0.1, 10, 0.02, cfg["floor_contact"], math.pi / 4, 0.0, 0.0, 0.05)
+    assert small[("desk", "chair", "spatial")].across == round(float(np.mean(abs(jitter) <= 0.03)), 3)
     spread = [_chair_across(furnished(s), j).room_input() for s, j in enumerate(np.linspace(-0.55, 0.55, 12))]
     assert learn(spread, 0.1, 0.0)[("desk", "chair", "spatial")].across == pytest.approx(2 / 12, abs=1e-3)
     assert ("desk", "chair", "spatial") not in learn(spread, 0.1, 3.0)

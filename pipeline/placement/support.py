@@ -118,22 +118,24 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
 
 
 def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float, floor_contact: float,
-                   facing: float, flush: float = 0.0, concentration: float = 0.0) -> dict[tuple[str, str, str], tuple]:
+                   facing: float, flush: float = 0.0, concentration: float = 0.0,
+                   fraction: float = 1.0) -> dict[tuple[str, str, str], tuple]:
     """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the :class:`CentreLine` of the
     training rooms' pairs: the shares whose object's centre lies within ``within`` m of the anchor's centre line across
-    it (local x = 0) and along it (local y = 0), with those pairs' offsets. ``support``: an object and the support it
+    it (local x = 0) and along it (local y = 0), and within ``fraction`` of the anchor's half extent on that axis (a
+    lamp on a nightstand: 10 cm is nearly half its top), with those pairs' offsets. ``support``: an object and the support it
     stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
     front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
     ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
     room), across. ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands
     within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median
     gap (m). A share needs ``min_pairs`` pairs and ``concentration`` times the share the same pairs would show spread
-    evenly over the anchor (``within`` over its half extent on that axis, at most 1), else it is 0: plants stand
+    evenly over the anchor (the window over its half extent, at most ``fraction``), else it is 0: plants stand
     within 10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
     seen, backs = centre_offsets(rooms, tolerance, floor_contact, facing)
     rules: dict[tuple[str, str, str], tuple] = {}
     for key, axes in sorted(seen.items()):
-        found = [_near_line(pairs, within, min_pairs, concentration) for pairs in axes]
+        found = [_near_line(pairs, within, min_pairs, concentration, fraction) for pairs in axes]
         if any(share for share, _ in found):
             rules[key] = CentreLine(found[0][0], found[1][0], found[0][1], found[1][1])
     share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
@@ -144,14 +146,18 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
     return rules
 
 
-def _near_line(pairs: np.ndarray, within: float, min_pairs: int, concentration: float) -> tuple[float, tuple[float, ...]]:
+def _near_line(pairs: np.ndarray, within: float, min_pairs: int, concentration: float,
+               fraction: float) -> tuple[float, tuple[float, ...]]:
     """The share of ``pairs (n, 2)`` (offset from the anchor's centre line, the anchor's half extent on that axis; m)
-    within ``within`` of the line and their offsets (rounded to mm); ``(0, (0,))`` with fewer than ``min_pairs`` pairs
-    or a share under ``concentration`` times the share an even spread over the anchor gives."""
-    near = np.abs(pairs[:, 0]) <= within
+    near the line (within ``within``, and within ``fraction`` of the anchor's half extent) and their offsets (rounded
+    to mm); ``(0, (0,))`` with fewer than ``min_pairs`` pairs or a share under ``concentration`` times the share an
+    even spread over the anchor gives."""
+    half = np.maximum(pairs[:, 1], 1e-9)
+    window = np.minimum(within, fraction * half)
+    near = np.abs(pairs[:, 0]) <= window
     if len(pairs) < min_pairs or not near.any():
         return 0.0, (0.0,)
-    chance = float(np.mean(np.minimum(1.0, within / np.maximum(pairs[:, 1], 1e-9))))
+    chance = float(np.mean(np.minimum(1.0, window / half)))
     share = float(near.mean())
     if share < concentration * chance:
         return 0.0, (0.0,)

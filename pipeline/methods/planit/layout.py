@@ -64,7 +64,8 @@ def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
     training = corpus.training()
     centring = learn_centring(training, snap["centre_within"], snap["centre_min_pairs"],
                               config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
-                              np.radians(snap["centre_facing_angle"]), snap["flush_within"], snap["centre_concentration"])
+                              np.radians(snap["centre_facing_angle"]), snap["flush_within"], snap["centre_concentration"],
+                              snap["centre_fraction"])
     wall_backs = learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
                                   snap["centre_min_pairs"], config["floor_contact"]) if snap["wall_back_gap"] > 0 else {}
     log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s",
