@@ -21,7 +21,7 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import BackToWall, Centred, Combined, FaceAway, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import instantiate
-from pipeline.placement.support import CentreLine, back_gap, learn_centring
+from pipeline.placement.support import CentreLine, Window, back_gap, learn_centring
 from pipeline.placement.walls import learn_wall_backs
 
 from conftest import Room, default_config
@@ -202,7 +202,7 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
     # learned: the hand-built rooms' televisions stand on their stands' middles and chairs on their desks' centre
     # lines, nightstands beside the bed's head (off its middle); 0.1 m off in both axes, no support rule
     cfg = default_config()
-    learn = lambda rooms, least=10: learn_centring(rooms, 0.02, least, 0.02, cfg["floor_contact"], math.pi / 4)
+    learn = lambda rooms, least=10: learn_centring(rooms, Window(0.02, least), 0.02, cfg["floor_contact"], math.pi / 4)
     rules = learn([furnished(s).room_input() for s in range(12)])
     assert rules[("tv_stand", "tv", "support")][:2] == (1.0, 1.0)
     assert rules[("desk", "chair", "spatial")][:2] == (1.0, 0.0) and ("bed", "nightstand", "spatial") not in rules
@@ -257,15 +257,15 @@ def test_objects_stand_as_far_off_their_anchors_centre_lines_as_in_the_training_
     # offsets, where a 2 cm line holds a third; chairs spread evenly over the desk's width (1.2 m) stand within 10 cm
     # of its line only as often as chance (1 in 6), which concentration 3 refuses
     cfg = default_config()
-    learn = lambda rooms, within, concentration: learn_centring(rooms, within, 10, 0.02, cfg["floor_contact"],
-                                                                math.pi / 4, 0.0, concentration)
+    learn = lambda rooms, within, concentration: learn_centring(rooms, Window(within, 10, concentration), 0.02,
+                                                                cfg["floor_contact"], math.pi / 4)
     jitter = np.round(np.random.default_rng(0).uniform(-0.06, 0.06, 12), 3)
     near = [_chair_across(furnished(s), j).room_input() for s, j in enumerate(jitter)]
     line = learn(near, 0.1, 3.0)[("desk", "chair", "spatial")]
     assert line.across == 1.0 and sorted(line.across_offsets) == pytest.approx(sorted(jitter), abs=1e-3)
     assert learn(near, 0.02, 0.0)[("desk", "chair", "spatial")].across == round(float(np.mean(abs(jitter) <= 0.02)), 3) < 0.5
     # the window is also at most a fraction of the anchor's half extent (0.05 of the desk's 0.6 m: 3 cm)
-    small = learn_centring(near, 0.1, 10, 0.02, cfg["floor_contact"], math.pi / 4, 0.0, 0.0, 0.05)
+    small = learn_centring(near, Window(0.1, fraction=0.05), 0.02, cfg["floor_contact"], math.pi / 4)
     assert small[("desk", "chair", "spatial")].across == round(float(np.mean(abs(jitter) <= 0.03)), 3)
     spread = [_chair_across(furnished(s), j).room_input() for s, j in enumerate(np.linspace(-0.55, 0.55, 12))]
     assert learn(spread, 0.1, 0.0)[("desk", "chair", "spatial")].across == pytest.approx(2 / 12, abs=1e-3)
@@ -358,7 +358,7 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
     # off it) or 5 cm off it (beyond flush_within, 3 cm) give none; too few pairs give none
     cfg = default_config()
     flush = cfg["instantiate"]["snap"]["flush_within"]
-    learn = lambda rooms, least=10: learn_centring(rooms, 0.02, least, 0.02, cfg["floor_contact"], math.pi / 4, flush)
+    learn = lambda rooms, least=10: learn_centring(rooms, Window(0.02, least), 0.02, cfg["floor_contact"], math.pi / 4, flush)
     centred = [furnished(s).room_input() for s in range(12)]
     assert min(back_gap(r.boxes.reshape(-1, 7)[r.object_ids.index("stand")],
                         r.boxes.reshape(-1, 7)[r.object_ids.index("tv")]) for r in centred) > flush
@@ -386,7 +386,7 @@ def test_two_objects_facing_each_other_stand_on_one_axis_as_in_the_training_room
     # learned: the hand-built rooms' chairs face their desks on the desk's centre line (both ways round); a chair
     # 0.1 m off it, or one turned away, gives no rule; the bed and the desk stand back to back, not facing
     cfg = default_config()
-    learn = lambda rooms: learn_centring(rooms, 0.02, 10, 0.02, cfg["floor_contact"], math.pi / 4)
+    learn = lambda rooms: learn_centring(rooms, Window(0.02), 0.02, cfg["floor_contact"], math.pi / 4)
     rules = learn([furnished(s).room_input() for s in range(12)])
     assert rules[("desk", "chair", "facing")][:2] == (1.0, 0.0) and rules[("chair", "desk", "facing")][:2] == (1.0, 0.0)
     assert not any(key[2] == "facing" and "bed" in key for key in rules)

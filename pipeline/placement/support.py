@@ -15,6 +15,7 @@ grid or network (PlanIT's location network: 0.15 m per pixel at the default pres
 which a television stands off its stand's middle or an office chair off its desk's."""
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -89,6 +90,17 @@ def back_gap(support: np.ndarray, obj: np.ndarray) -> float:
 Key = tuple[str, str, str]
 
 
+@dataclass(frozen=True)
+class Window:
+    """What counts as near an anchor's centre line: within ``within`` m of it and within ``fraction`` of the anchor's
+    half extent on that axis; a share of pairs near it needs ``min_pairs`` pairs and ``concentration`` times the share
+    an even spread over the anchor gives (``instantiate.snap``'s ``centre_*`` settings)."""
+    within: float
+    min_pairs: int = 10
+    concentration: float = 0.0
+    fraction: float = 1.0
+
+
 def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: float,
                    facing: float) -> tuple[dict[Key, tuple[np.ndarray, np.ndarray]], dict[Key, list[float]]]:
     """The pairs :func:`learn_centring` reads: (anchor category, object category, kind) -> ``(across (n, 2), along
@@ -117,28 +129,26 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
     return {key: (as_rows(across), as_rows(along)) for key, (across, along) in seen.items()}, backs
 
 
-def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolerance: float, floor_contact: float,
-                   facing: float, flush: float = 0.0, concentration: float = 0.0,
-                   fraction: float = 1.0) -> dict[tuple[str, str, str], tuple]:
+def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, floor_contact: float, facing: float,
+                   flush: float = 0.0) -> dict[tuple[str, str, str], tuple]:
     """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the :class:`CentreLine` of the
-    training rooms' pairs: the shares whose object's centre lies within ``within`` m of the anchor's centre line across
-    it (local x = 0) and along it (local y = 0), and within ``fraction`` of the anchor's half extent on that axis (a
-    lamp on a nightstand: 10 cm is nearly half its top), with those pairs' offsets. ``support``: an object and the support it
+    training rooms' pairs: the shares whose object's centre lies in the ``window`` about the anchor's centre line
+    across it (local x = 0) and along it (local y = 0) (a lamp on a nightstand: 10 cm is nearly half its top, so the
+    window is also a fraction of the anchor), with those pairs' offsets. ``support``: an object and the support it
     stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
     front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
     ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
     room), across. ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands
     within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median
-    gap (m). A share needs ``min_pairs`` pairs and ``concentration`` times the share the same pairs would show spread
-    evenly over the anchor (the window over its half extent, at most ``fraction``), else it is 0: plants stand
-    within 10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
+    gap (m). A share needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within
+    10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
     seen, backs = centre_offsets(rooms, tolerance, floor_contact, facing)
     rules: dict[tuple[str, str, str], tuple] = {}
     for key, axes in sorted(seen.items()):
-        found = [_near_line(pairs, within, min_pairs, concentration, fraction) for pairs in axes]
+        found = [_near_line(pairs, window) for pairs in axes]
         if any(share for share, _ in found):
             rules[key] = CentreLine(found[0][0], found[1][0], found[0][1], found[1][1])
-    share = lambda flags: float(np.mean(flags)) if len(flags) >= min_pairs else 0.0
+    share = lambda flags: float(np.mean(flags)) if len(flags) >= window.min_pairs else 0.0
     for key, gaps in sorted(backs.items()):
         flush_share = share([abs(g) <= flush for g in gaps])
         if flush_share:
@@ -146,19 +156,17 @@ def learn_centring(rooms: list[RoomInput], within: float, min_pairs: int, tolera
     return rules
 
 
-def _near_line(pairs: np.ndarray, within: float, min_pairs: int, concentration: float,
-               fraction: float) -> tuple[float, tuple[float, ...]]:
+def _near_line(pairs: np.ndarray, window: Window) -> tuple[float, tuple[float, ...]]:
     """The share of ``pairs (n, 2)`` (offset from the anchor's centre line, the anchor's half extent on that axis; m)
-    near the line (within ``within``, and within ``fraction`` of the anchor's half extent) and their offsets (rounded
-    to mm); ``(0, (0,))`` with fewer than ``min_pairs`` pairs or a share under ``concentration`` times the share an
-    even spread over the anchor gives."""
+    in the ``window`` and their offsets (rounded to mm); ``(0, (0,))`` with fewer than its ``min_pairs`` pairs or a
+    share under its ``concentration`` times the share an even spread over the anchor gives."""
     half = np.maximum(pairs[:, 1], 1e-9)
-    window = np.minimum(within, fraction * half)
-    near = np.abs(pairs[:, 0]) <= window
-    if len(pairs) < min_pairs or not near.any():
+    reach = np.minimum(window.within, window.fraction * half)
+    near = np.abs(pairs[:, 0]) <= reach
+    if len(pairs) < window.min_pairs or not near.any():
         return 0.0, (0.0,)
-    chance = float(np.mean(np.minimum(1.0, window / half)))
+    chance = float(np.mean(np.minimum(1.0, reach / half)))
     share = float(near.mean())
-    if share < concentration * chance:
+    if share < window.concentration * chance:
         return 0.0, (0.0,)
     return round(share, 3), tuple(float(o) for o in np.round(pairs[near, 0], 3))

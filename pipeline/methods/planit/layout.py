@@ -20,7 +20,7 @@ from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from ...placement.search import SCORED, instantiate
-from ...placement.support import learn_centring
+from ...placement.support import Window, learn_centring
 from ...placement.walls import learn_wall_backs
 from ...seeding import seed_of
 from ..interface import Corpus, Scene, Task
@@ -62,10 +62,9 @@ def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
     supports, beside floor anchors and facing each other, and backs to walls."""
     snap = config["instantiate"]["snap"]
     training = corpus.training()
-    centring = learn_centring(training, snap["centre_within"], snap["centre_min_pairs"],
-                              config["instantiate"]["checks"]["learned_support"]["tolerance"], config["floor_contact"],
-                              np.radians(snap["centre_facing_angle"]), snap["flush_within"], snap["centre_concentration"],
-                              snap["centre_fraction"])
+    window = Window(snap["centre_within"], snap["centre_min_pairs"], snap["centre_concentration"], snap["centre_fraction"])
+    centring = learn_centring(training, window, config["instantiate"]["checks"]["learned_support"]["tolerance"],
+                              config["floor_contact"], np.radians(snap["centre_facing_angle"]), snap["flush_within"])
     wall_backs = learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
                                   snap["centre_min_pairs"], config["floor_contact"]) if snap["wall_back_gap"] > 0 else {}
     log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s",
