@@ -44,7 +44,7 @@ def _room_reasons(room, segs: np.ndarray, objs: dict, cfg: dict, rare: set) -> l
         out.append(("room_size", f"extents {room.extent_x:.2f} x {room.extent_y:.2f} m outside "
                                  f"[{cfg['min_extent']}, {cfg['max_extent']}] m"))
     b = objs["boxes"]
-    floor = int((b[:, 2] - b[:, 5] <= cfg["floor_contact"]).sum())
+    floor = int(boxes.on_floor(b, cfg["floor_contact"]).sum())
     if floor < cfg["min_floor_objects"][rtype]:
         out.append(("too_few_objects", f"{floor} floor objects < {cfg['min_floor_objects'][rtype]}"))
     if len(b) > cfg["max_objects"][rtype]:

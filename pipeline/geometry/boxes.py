@@ -32,6 +32,12 @@ def footprint_corners(cx: ArrayLike, cy: ArrayLike, hx: ArrayLike, hy: ArrayLike
     return cast(np.ndarray, world + np.stack([cx, cy], -1)[:, None, :])
 
 
+def on_floor(boxes: np.ndarray, floor_contact: float) -> np.ndarray:
+    """``(n,)`` bool: the boxes ``(n, 7)`` whose bottom lies within ``floor_contact`` m of the floor (z = 0)."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    return cast(np.ndarray, b[:, 2] - b[:, 5] <= floor_contact)
+
+
 def diagonal_2d(hx: ArrayLike, hy: ArrayLike) -> np.ndarray:
     """Footprint diagonal length."""
     return cast(np.ndarray, 2.0 * np.hypot(hx, hy))

@@ -20,6 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..geometry.boxes import on_floor
 from ..geometry.frames import to_local
 from ..geometry.function import REGIONS, facing_each_other, offsets, regions
 from ..room import RoomInput
@@ -31,8 +32,9 @@ FRONT, BACK, SIDE_FRONT, SIDE_BACK = (REGIONS.index(r) for r in ("front", "back"
 
 class CentreLine(NamedTuple):
     """Where the training pairs of one (anchor category, object category, kind) stand about the anchor's centre
-    lines: the shares ``across`` and ``along`` of the pairs whose object's centre lies within ``within`` m of the line
-    (local x = 0, local y = 0), and those pairs' signed offsets (m), which the search draws from (0: on the line)."""
+    lines: the shares ``across`` and ``along`` of the pairs whose object's centre lies in the :class:`Window` about the
+    line (local x = 0, local y = 0), and those pairs' signed offsets (m), which the search draws from (0: on the
+    line)."""
 
     across: float
     along: float
@@ -106,8 +108,8 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
     """The pairs :func:`learn_centring` reads: (anchor category, object category, kind) -> ``(across (n, 2), along
     (m, 2))``, each row an object's signed offset from the anchor's centre line and the anchor's half extent on that
     axis (m); and (support category, object category, ``back``) -> the pairs' :func:`back_gap` (m)."""
-    seen: dict[tuple[str, str, str], tuple[list[tuple[float, float]], list[tuple[float, float]]]] = {}
-    backs: dict[tuple[str, str, str], list[float]] = {}
+    seen: dict[Key, tuple[list[tuple[float, float]], list[tuple[float, float]]]] = {}
+    backs: dict[Key, list[float]] = {}
     for room in rooms:
         b, cats = room.boxes.reshape(-1, 7), room.categories
         for k, j, _ in support_pairs(room, tolerance, floor_contact):
@@ -116,7 +118,7 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
             lines[0].append((float(u), float(b[j, 3])))
             lines[1].append((float(v), float(b[j, 4])))
             backs.setdefault((cats[j], cats[k], "back"), []).append(back_gap(b[j], b[k]))
-        floor = np.flatnonzero(b[:, 2] - b[:, 5] <= floor_contact)
+        floor = np.flatnonzero(on_floor(b, floor_contact))
         fb, fcats = b[floor], [cats[k] for k in floor]
         off, region = offsets(fb), regions(fb)  # (a, t, 2) m, (a, t) index into REGIONS
         lined = ((np.isin(region, (FRONT, BACK)), "spatial", 0), (np.isin(region, (SIDE_FRONT, SIDE_BACK)), "spatial", 1),
@@ -130,7 +132,7 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
 
 
 def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, floor_contact: float, facing: float,
-                   flush: float = 0.0) -> dict[tuple[str, str, str], tuple]:
+                   flush: float = 0.0) -> dict[Key, tuple]:
     """(anchor category, object category, ``support`` | ``spatial`` | ``facing``) -> the :class:`CentreLine` of the
     training rooms' pairs: the shares whose object's centre lies in the ``window`` about the anchor's centre line
     across it (local x = 0) and along it (local y = 0) (a lamp on a nightstand: 10 cm is nearly half its top, so the
@@ -143,7 +145,7 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
     gap (m). A share needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within
     10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
     seen, backs = centre_offsets(rooms, tolerance, floor_contact, facing)
-    rules: dict[tuple[str, str, str], tuple] = {}
+    rules: dict[Key, tuple] = {}
     for key, axes in sorted(seen.items()):
         found = [_near_line(pairs, window) for pairs in axes]
         if any(share for share, _ in found):

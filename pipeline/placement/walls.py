@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.boxes import on_floor
 from ..geometry.function import back_to_wall
 from ..room import RoomInput
 
@@ -19,7 +20,7 @@ def learn_wall_backs(rooms: list[RoomInput], gap: float, angle: float, min_pairs
     against: dict[str, list[bool]] = {}
     for room in rooms:
         b = room.boxes.reshape(-1, 7)
-        floor = np.flatnonzero(b[:, 2] - b[:, 5] <= floor_contact)
+        floor = np.flatnonzero(on_floor(b, floor_contact))
         if not len(floor):
             continue
         near = back_to_wall(b[floor], room.outline, gap, angle, ["rotational-4"] * len(floor))  # any side
