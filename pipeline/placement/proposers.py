@@ -193,6 +193,48 @@ class BackToWall:
         return xy, float(away[np.argmin(turn_error(away - yaw))])
 
 
+class FacingPartner:
+    """A proposer whose floor objects face a placed object their plan says nothing of as often as the training rooms'
+    objects of their category face one of that category (``shares``: (partner category, object category) -> share,
+    :func:`~pipeline.placement.partners.learn_facing_partners`): with the largest such share among the placed
+    partners, the pose is drawn from the base proposer conditioned on facing one of them within ``facing`` rad
+    (:func:`~pipeline.geometry.function.facing_each_other`), by drawing up to ``tries`` poses and keeping the first that
+    does (else the first drawn). A partner the object has a planned edge to is the plan's; an object on a support has
+    none."""
+
+    def __init__(self, base, shares: dict[tuple[str, str], float], facing: float, tries: int):
+        self.base, self.shares, self.facing, self.tries = base, shares, facing, tries
+
+    def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        first = self.base.pose(req, rng)
+        partners = self._partners(req)
+        if first is None or not len(partners):
+            return first
+        share = max(self.shares[(req.room.categories[o], req.category)] for o in partners)
+        if rng.random() >= share:
+            return first
+        drawn: tuple[np.ndarray, float] | None = first
+        for _ in range(self.tries):
+            if drawn is None:
+                break
+            if self._faces(req, partners, *drawn):
+                return drawn
+            drawn = self.base.pose(req, rng)
+        return first
+
+    def _partners(self, req: Request) -> np.ndarray:
+        """Indices of the placed objects of a partner category the plan gives the object no edge to."""
+        if any(a.kind == SUPPORT for a in req.anchors):
+            return np.zeros(0, int)
+        planned = {req.room.categories[a.obj] for a in req.anchors if a.obj is not None}
+        cats = req.room.categories
+        return np.array([k for k, c in enumerate(cats) if (c, req.category) in self.shares and c not in planned], int)
+
+    def _faces(self, req: Request, partners: np.ndarray, xy: np.ndarray, yaw: float) -> bool:
+        boxes = np.vstack([req.room.boxes.reshape(-1, 7)[partners], [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
+        return bool(facing_each_other(boxes, self.facing)[:-1, -1].any())
+
+
 class Combined(DensityProposer):
     """Locations from one proposer, orientations from another."""
 

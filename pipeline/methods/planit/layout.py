@@ -17,6 +17,7 @@ from ...learning import checkpoint
 from ...log import progress
 from ...placement import order, proposers
 from ...placement.layout import walls_of, with_objects
+from ...placement.partners import learn_facing_partners
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from ...placement.search import SCORED, instantiate
@@ -35,16 +36,21 @@ log = logging.getLogger("planit.instantiate")
 class PoseRules:
     """What the training rooms say about poses beyond the proposer's draw: centre-line and back-edge rules per
     (anchor, object, kind) (:func:`~pipeline.placement.support.learn_centring`) and per category the share of
-    objects against a wall that have their back to it (:func:`~pipeline.placement.walls.learn_wall_backs`)."""
+    objects against a wall that have their back to it (:func:`~pipeline.placement.walls.learn_wall_backs`); per
+    (partner, object) category the share of objects facing a partner (:func:`~pipeline.placement.partners.
+    learn_facing_partners`)."""
     centring: dict = field(default_factory=dict)
     wall_backs: dict = field(default_factory=dict)
+    partners: dict = field(default_factory=dict)
 
 
 def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRules | None = None):
     """The variant's proposer (``cfg``: its instantiate settings, ``extract``: the extraction's): the pose networks
     (their densities weighted by the relation bands when ``relation_mask``), the relative-pose prior (likewise), or
     uniform or rule-band locations with the networks' orientations; when the variant snaps, objects planned against a
-    wall turned with their back to it (:class:`~pipeline.placement.proposers.BackToWall`) and put on the centre lines
+    wall turned with their back to it (:class:`~pipeline.placement.proposers.BackToWall`), drawn facing the placed
+    objects the training rooms' objects face unplanned (:class:`~pipeline.placement.proposers.FacingPartner`), and put
+    on the centre lines
     of their supports, planned floor anchors and the placed objects they face
     (:class:`~pipeline.placement.proposers.Centred`) by the training rooms' ``rules``."""
     base = location_proposer(location, saved, cfg, extract)
@@ -52,6 +58,9 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRul
         return base
     if rules.wall_backs:
         base = proposers.BackToWall(base, rules.wall_backs)
+    if rules.partners:
+        snap = cfg["snap"]
+        base = proposers.FacingPartner(base, rules.partners, np.radians(snap["centre_facing_angle"]), snap["partner_tries"])
     if rules.centring:
         base = proposers.Centred(base, rules.centring, np.radians(cfg["snap"]["centre_facing_angle"]))
     return base
@@ -67,9 +76,12 @@ def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
                               config["floor_contact"], np.radians(snap["centre_facing_angle"]), snap["flush_within"])
     wall_backs = learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
                                   snap["centre_min_pairs"], config["floor_contact"]) if snap["wall_back_gap"] > 0 else {}
-    log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s",
-             corpus.room_type, {"/".join(key): tuple(v[:2]) for key, v in centring.items()}, wall_backs)
-    return PoseRules(centring, wall_backs)
+    partners = learn_facing_partners(training, np.radians(snap["centre_facing_angle"]), snap["centre_min_pairs"],
+                                     snap["partner_min_share"], config["floor_contact"]) if snap["partner_tries"] else {}
+    log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s; facing "
+             "partners %s", corpus.room_type, {"/".join(key): tuple(v[:2]) for key, v in centring.items()}, wall_backs,
+             {"/".join(pair): share for pair, share in partners.items()})
+    return PoseRules(centring, wall_backs, partners)
 
 
 def location_proposer(location: str, saved, cfg: dict, extract: dict):
