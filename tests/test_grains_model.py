@@ -12,6 +12,7 @@ import pytest
 import torch
 
 from pipeline.learning import checkpoint
+from pipeline.learning.epochs import Session
 from pipeline.methods.grains import train
 from pipeline.methods.grains.hierarchy import KINDS, Node, build_tree, describe, layout, leaves, room_rect, tree_depth
 from pipeline.methods.grains.model import CODE, GrainsVAE, Sizes
@@ -177,7 +178,7 @@ def strip(history: list[dict]) -> list[dict]:
 
 def test_training_resumes_exactly_and_starts_over_under_another_hash(tmp_path):
     fit, val = small_rooms(12, 3), small_rooms(4, 4)
-    whole = train.train(fit, val, LABELS, SMALL, 5, tmp_path / "a.pt", "h1", "cpu")
+    whole = train.train(fit, val, LABELS, SMALL, Session(5, tmp_path / "a.pt", "h1"))
     assert whole.resumed_from == 0 and [r["epoch"] for r in whole.history] == [1, 2, 3]
     assert all(set(r) == {"epoch", "train_loss", "train_kl", "validation_loss", "seconds", "trees_per_s"}
                for r in whole.history)
@@ -185,15 +186,15 @@ def test_training_resumes_exactly_and_starts_over_under_another_hash(tmp_path):
     saved = checkpoint.load(tmp_path / "a.pt", train.PROGRESS, "h1")
     assert saved.record["epoch"] == 3
     ticks = []
-    cut = train.train(fit, val, LABELS, {**SMALL, "max_epochs": 2}, 5, tmp_path / "b.pt", "h1", "cpu",
-                      tick=lambda e, row: ticks.append(e))
+    cut = train.train(fit, val, LABELS, {**SMALL, "max_epochs": 2}, Session(5, tmp_path / "b.pt", "h1",
+                                                                                 tick=lambda e, row: ticks.append(e)))
     assert ticks == [1, 2] and cut.resumed_from == 0
-    resumed = train.train(fit, val, LABELS, SMALL, 5, tmp_path / "b.pt", "h1", "cpu")
+    resumed = train.train(fit, val, LABELS, SMALL, Session(5, tmp_path / "b.pt", "h1"))
     assert resumed.resumed_from == 2 and strip(resumed.history) == strip(whole.history)
     assert resumed.best_epoch == whole.best_epoch
     for p, q in zip(resumed.model.parameters(), whole.model.parameters()):
         assert torch.equal(p, q)
-    other = train.train(fit, val, LABELS, SMALL, 5, tmp_path / "b.pt", "h2", "cpu")
+    other = train.train(fit, val, LABELS, SMALL, Session(5, tmp_path / "b.pt", "h2"))
     assert other.resumed_from == 0 and strip(other.history) == strip(whole.history)
 
 
@@ -202,7 +203,7 @@ def test_selection_by_samples_keeps_the_checked_epoch_whose_prior_is_nearest_the
     trees (category KL), the kept weights are those of the lowest score, and they reproduce it."""
     fit, val = small_rooms(12, 3), small_rooms(4, 4)
     preset = {**SMALL, "max_epochs": 6, "patience": 6, "select": "samples", "select_every": 2, "select_samples": 8}
-    run = train.train(fit, val, LABELS, preset, 5, tmp_path / "a.pt", "h1", "cpu")
+    run = train.train(fit, val, LABELS, preset, Session(5, tmp_path / "a.pt", "h1"))
     checked = {r["epoch"]: r["sample_kl"] for r in run.history if "sample_kl" in r}
     assert list(checked) == [2, 4, 6] and all(np.isfinite(v) and v >= 0 for v in checked.values())
     assert run.best_epoch == min(checked, key=checked.get)
@@ -214,5 +215,5 @@ def test_selection_by_samples_stops_after_patience_epochs_without_a_gain(tmp_pat
     epochs after its best check."""
     fit, val = small_rooms(12, 3), small_rooms(4, 4)
     preset = {**SMALL, "max_epochs": 40, "patience": 3, "select": "samples", "select_every": 2, "select_samples": 8}
-    run = train.train(fit, val, LABELS, preset, 5, tmp_path / "a.pt", "h1", "cpu")
+    run = train.train(fit, val, LABELS, preset, Session(5, tmp_path / "a.pt", "h1"))
     assert len(run.history) < 40 and len(run.history) - run.best_epoch <= 3

@@ -17,6 +17,7 @@ from pipeline.graphs import (
     data as graph_data,  # noqa: E402
 )
 from pipeline.graphs.data import OBJECT_EDGES, Graph  # noqa: E402
+from pipeline.learning.epochs import Session  # noqa: E402
 from pipeline.methods.planit.graph_model import (
     sampler,  # noqa: E402
     spec,  # noqa: E402
@@ -114,7 +115,7 @@ def bed_lamp_graph(real: Graph, vocab) -> Graph:
 def test_tiny_model_overfits_a_graph_and_greedy_sampling_reproduces_it(bedrooms, tmp_path):
     vocab, graphs = bedrooms
     g = bed_lamp_graph(graphs[0], vocab)
-    run = train.train([g], [g], vocab, {**TINY, "max_epochs": 120, "patience": 120}, 10, 0, tmp_path / "ck.pt", "h")
+    run = train.train([g], [g], vocab, {**TINY, "max_epochs": 120, "patience": 120}, 10, Session(0, tmp_path / "ck.pt", "h"))
     assert run.history[-1]["validation_nll"] < 0.05 * run.history[0]["validation_nll"]
     out = sampler.sample(run.model, vocab, [g], seed=0, temperature=0.0, max_objects=25, max_edges=10)[0]
     assert same_graph(out.node_class, out.edges, g)
@@ -123,21 +124,21 @@ def test_tiny_model_overfits_a_graph_and_greedy_sampling_reproduces_it(bedrooms,
 def test_resuming_from_a_checkpoint_gives_the_weights_of_an_uninterrupted_run(bedrooms, tmp_path):
     vocab, graphs = bedrooms
     tr, held = graphs[:-2], graphs[-2:]
-    whole = train.train(tr, held, vocab, {**TINY, "max_epochs": 4, "patience": 99}, 10, 3, tmp_path / "a.pt", "h")
-    train.train(tr, held, vocab, {**TINY, "max_epochs": 2, "patience": 99}, 10, 3, tmp_path / "b.pt", "h")  # interrupted
-    resumed = train.train(tr, held, vocab, {**TINY, "max_epochs": 4, "patience": 99}, 10, 3, tmp_path / "b.pt", "h")
+    whole = train.train(tr, held, vocab, {**TINY, "max_epochs": 4, "patience": 99}, 10, Session(3, tmp_path / "a.pt", "h"))
+    train.train(tr, held, vocab, {**TINY, "max_epochs": 2, "patience": 99}, 10, Session(3, tmp_path / "b.pt", "h"))  # interrupted
+    resumed = train.train(tr, held, vocab, {**TINY, "max_epochs": 4, "patience": 99}, 10, Session(3, tmp_path / "b.pt", "h"))
     assert resumed.resumed_from == 2 and len(resumed.history) == 4
     for k, v in whole.model.state_dict().items():
         assert torch.equal(v, resumed.model.state_dict()[k]), k
-    other = train.train(tr, held, vocab, {**TINY, "max_epochs": 1, "patience": 99}, 10, 3, tmp_path / "b.pt", "other")
+    other = train.train(tr, held, vocab, {**TINY, "max_epochs": 1, "patience": 99}, 10, Session(3, tmp_path / "b.pt", "other"))
     assert other.resumed_from == 0  # a checkpoint of other settings is not resumed
 
 
 @pytest.fixture(scope="module")
 def model(bedrooms, tmp_path_factory):
     vocab, graphs = bedrooms
-    run = train.train(graphs[:-1], graphs[-1:], vocab, {**TINY, "max_epochs": 15}, 10, 0,
-                      tmp_path_factory.mktemp("m") / "ck.pt", "h")
+    run = train.train(graphs[:-1], graphs[-1:], vocab, {**TINY, "max_epochs": 15}, 10,
+                      Session(0, tmp_path_factory.mktemp("m") / "ck.pt", "h"))
     return run.model
 
 

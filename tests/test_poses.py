@@ -104,6 +104,7 @@ def learned(tmp_path_factory):
     import torch
 
     from pipeline.learning.checkpoint import Checkpoint
+    from pipeline.learning.epochs import Session
     from pipeline.methods.planit.nets import train as nets_train
     from pipeline.placement.prior import learn_prior
 
@@ -114,12 +115,38 @@ def learned(tmp_path_factory):
     cats = tuple(sorted(SIZES))
     torch.set_num_threads(1)
     progress = tmp_path_factory.mktemp("nets") / "progress.pt"
-    nets, _ = nets_train.train(rooms[:34], rooms[34:], cats, preset, True, 0, progress, "test", "cpu", None,
+    nets, _ = nets_train.train(rooms[:34], rooms[34:], cats, preset, True, Session(0, progress, "test"),
                                {"snap_angle": 5.0, "none_share": 0.1})
     saved = Checkpoint("placement_nets", "test", {"nets": [n.state_dict() for n in nets]},
                        {"categories": list(cats), "preset": preset, "snap_angle": 5.0})
     prior = Checkpoint("pose_prior", "test", {}, learn_prior([(t.room, t.edges) for t in rooms], cfg["placement"]["prior"]))
     return {"cfcn": saved, "prior": prior}, pool_room
+
+
+def test_placement_training_resumed_after_an_interrupt_ends_with_the_weights_of_an_uninterrupted_run(tmp_path):
+    import torch
+
+    from pipeline.learning.epochs import Session
+    from pipeline.methods.planit.nets import train as nets_train
+
+    rooms, _ = corpus(6)
+    preset = {**default_config()["placement"]["presets"]["tiny"], "steps": 4, "batch_size": 4, "log_every": 2,
+              "checkpoint_every": 2, "heldout_examples": 4}
+    run = lambda steps, name, chash="h", ticks=None: nets_train.train(
+        rooms[:5], rooms[5:], tuple(sorted(SIZES)), {**preset, "steps": steps}, True,
+        Session(0, tmp_path / name, chash, tick=None if ticks is None else lambda step, row: ticks.append(step)))
+    torch.set_num_threads(1)
+    whole, history = run(4, "a.pt")
+    ticks: list[int] = []
+    run(2, "b.pt", ticks=ticks)  # interrupted after its checkpoint at step 2
+    resumed, resumed_history = run(4, "b.pt")
+    assert ticks == [2] and [r["step"] for r in resumed_history] == [r["step"] for r in history] == [2, 4]
+    for a, b in zip(whole, resumed):
+        for k, v in a.state_dict().items():
+            assert torch.equal(v, b.state_dict()[k]), k
+    other, fresh = run(2, "b.pt", "other")[0], run(2, "c.pt")[0]  # a progress file of other settings is not resumed
+    assert all(torch.equal(v, fresh[0].state_dict()[k]) for k, v in other[0].state_dict().items())
+    assert not all(torch.equal(v, whole[0].state_dict()[k]) for k, v in other[0].state_dict().items())
 
 
 def setup_room(pool_room: Room, width=4.4, depth=4.6):

@@ -10,6 +10,7 @@ from hypothesis import given, strategies as st
 from pipeline.geometry.frames import Frame
 from pipeline.geometry.raycast import intersector_class
 from pipeline.graphs.data import EDGE_CLASSES, Graph, Vocab
+from pipeline.learning.epochs import Session
 from pipeline.methods.strings import assemble, poses, tagger
 from pipeline.methods.strings.serialize import tokens
 from pipeline.methods.strings.tagfit import tagger_room, token_vocab
@@ -126,7 +127,7 @@ def test_the_tagger_learns_which_side_of_the_wall_a_nightstand_takes(tmp_path):
     held = [tagger_room(g, VOCAB, posed(r, g), clusters) for r, g in (bedroom(f"h{k}", 1.6 + 0.2 * k) for k in range(4))]
     tokens_ = token_vocab(rooms, rooms + held, 0, 4)
     preset = {**cfg["presets"]["tiny"], "max_epochs": 40, "patience": 40, "strings_per_room": 4, "lr": 0.02}
-    model, history, _ = tagger.train(rooms, rooms[:2], clusters, tokens_, preset, 0, tmp_path / "progress.pt", "h")
+    model, history, _ = tagger.train(rooms, rooms[:2], clusters, tokens_, preset, Session(0, tmp_path / "progress.pt", "h"))
     got = tagger.accuracy(model, held, clusters, tokens_, 3, 0)
     assert got["edges_with_choice"] == 8 and got["majority_with_choice"] == 0.5
     assert got["accuracy_with_choice"] == 1.0 and got["accuracy"] == 1.0

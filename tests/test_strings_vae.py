@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from pipeline.learning.epochs import Session
 from pipeline.methods.strings import sample as decoding, train
 from pipeline.methods.strings.grammar import learn_grammar
 from pipeline.methods.strings.serialize import StringError, arch_prefix, parse, serialize_room
@@ -82,20 +83,20 @@ def test_the_grammar_mask_writes_only_graphs_the_training_grammar_holds():
 def test_an_interrupted_training_resumes_to_the_same_weights(tmp_path):
     rooms = [ROOM] * 3
     vocab = vocab_of(rooms)
-    straight = train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 4}, 0, tmp_path / "a.pt", "h")
-    train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 2}, 0, tmp_path / "b.pt", "h")
-    resumed = train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 4}, 0, tmp_path / "b.pt", "h")
+    straight = train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 4}, Session(0, tmp_path / "a.pt", "h"))
+    train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 2}, Session(0, tmp_path / "b.pt", "h"))
+    resumed = train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 4}, Session(0, tmp_path / "b.pt", "h"))
     assert resumed.resumed_from == 2 and len(resumed.history) == 4
     for k, v in straight.model.state_dict().items():
         assert torch.equal(v, resumed.model.state_dict()[k]), k
-    other = train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 4}, 0, tmp_path / "b.pt", "other settings")
+    other = train.train(rooms, [ROOM], vocab, {**PRESET, "max_epochs": 4}, Session(0, tmp_path / "b.pt", "other settings"))
     assert other.resumed_from == 0  # a progress file of other settings is not resumed
 
 
 def test_a_room_learned_by_heart_decodes_back_from_its_code(tmp_path):
     vocab = vocab_of([ROOM])
     preset = {**PRESET, "max_epochs": 150, "kl_anneal": 50, "lr": 0.01}
-    run = train.train([ROOM], [ROOM], vocab, preset, 0, tmp_path / "p.pt", "h")
+    run = train.train([ROOM], [ROOM], vocab, preset, Session(0, tmp_path / "p.pt", "h"))
     text = serialize_room(*ROOM)
     mu = decoding.encode_means(run.model, [text], vocab, 200)
     prefix = vocab.encode([arch_prefix(*ROOM)[0] + "."])[0, 1:-1].tolist()

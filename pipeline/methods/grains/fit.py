@@ -10,6 +10,7 @@ import pandas as pd
 import torch
 
 from ...config import config_hash
+from ...learning import epochs
 from ...learning.checkpoint import Checkpoint
 from ...learning.device import pick_device
 from ...learning.fitted import Fitted, epoch_figure
@@ -48,8 +49,8 @@ def fit_grains(config: dict, room_type: str, net: str, node_df: pd.DataFrame, ed
     chash = config_hash({"preset": preset, "seed": config["seed"], "room_type": room_type, "split": ids,
                          "labels": labels, "wall_gap": gc["wall_gap"]})
     bar = iter(progress(range(preset["max_epochs"]), desc=f"GRAINS VAE {room_type} (max {preset['max_epochs']} epochs)"))
-    run = train.train(trees["fit"], trees["validation"], labels, preset, config["seed"], progress_file, chash, device,
-                      lambda epoch, row: next(bar, None))
+    run = train.train(trees["fit"], trees["validation"], labels, preset,
+                      epochs.Session(config["seed"], progress_file, chash, device, lambda epoch, row: next(bar, None)))
     held = [t for t in trees["heldout"] if all(leaf.label in labels for leaf in leaves(t))]
     test = {k: round(v, 4) for k, v in train.score(run.model, held, preset).items()} if held else {}
     history = pd.DataFrame(run.history)

@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
-from pathlib import Path
 
 import torch
 
@@ -35,12 +33,7 @@ KIND, PROGRESS = "grains_vae", "grains_vae.progress"
 CLIP = 1.0  # gradient norm clip when the preset names none
 
 
-@dataclass
-class Run:
-    model: GrainsVAE
-    history: list[dict]
-    best_epoch: int
-    resumed_from: int
+Run = epochs.Run
 
 
 def build_model(labels: list[str], preset: dict) -> GrainsVAE:
@@ -103,30 +96,24 @@ def judge(model: GrainsVAE, held_out: list[Node], preset: dict, seed: int, epoch
     return row["sample_kl"], True
 
 
-def train(fit: list[Node], val: list[Node], labels: list[str], preset: dict, seed: int, progress_file: Path,
-          chash: str, device: str = "cpu", tick=None) -> Run:
+def train(fit: list[Node], val: list[Node], labels: list[str], preset: dict, session: epochs.Session) -> Run:
     """Fit the VAE on the ``fit`` trees, stopping early on the ``val`` trees' loss (the fit trees' when there are
-    none); ``tick(epoch, row)`` is called after every epoch. See the module docstring."""
-    torch.manual_seed(seed)
-    model = build_model(labels, preset).to(device)
+    none; :func:`~pipeline.learning.epochs.fit`). See the module docstring."""
+    torch.manual_seed(session.seed)
+    model = build_model(labels, preset).to(session.device)
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
-    state = epochs.resume(model, opt, progress_file, PROGRESS, chash, device)
-    resumed, held_out = state["epoch"], val or fit
-    while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
-        epoch = state["epoch"] + 1
+    held_out = val or fit
+
+    def epoch(n: int, best: float) -> tuple[dict, float, bool]:
         start = time.perf_counter()
-        loss, kl = _epoch(model, opt, fit, preset, seed, epoch)
+        loss, kl = _epoch(model, opt, fit, preset, session.seed, n)
         seconds = time.perf_counter() - start
         validation = score(model, held_out, preset)["total"]
-        row = {"epoch": epoch, "train_loss": loss, "train_kl": kl, "validation_loss": validation,
+        row = {"epoch": n, "train_loss": loss, "train_kl": kl, "validation_loss": validation,
                "seconds": seconds, "trees_per_s": len(fit) / max(seconds, 1e-9)}
-        judged, checked = judge(model, held_out, preset, seed, epoch, row)
-        epochs.record(state, model, opt, row, judged, checked and judged < state["best"], progress_file, PROGRESS,
-                      chash)
-        log.info("epoch %d: loss %.4f (kl %.4f), validation %.4f, %.1f trees/s", epoch, loss, kl, validation,
+        judged, checked = judge(model, held_out, preset, session.seed, n, row)
+        log.info("epoch %d: loss %.4f (kl %.4f), validation %.4f, %.1f trees/s", n, loss, kl, validation,
                  row["trees_per_s"])
-        if tick:
-            tick(epoch, row)
-    if state["best_state"] is not None:
-        model.load_state_dict(state["best_state"])
-    return Run(model, state["history"], state["best_epoch"] or state["epoch"], resumed)
+        return row, judged, checked and judged < best
+
+    return epochs.fit(model, opt, session, PROGRESS, preset, epoch)

@@ -11,6 +11,7 @@ import torch
 from ...config import config_hash
 from ...graphs.data import Graph, Vocab
 from ...graphs.files import split_graphs
+from ...learning import epochs
 from ...learning.checkpoint import Checkpoint
 from ...learning.device import pick_device
 from ...learning.fitted import Fitted, epoch_figure
@@ -58,7 +59,7 @@ def fit_room_type(config: dict, vocab: Vocab, graphs: list[Graph], split: dict[s
         log.info("epoch %d: beta %.2f, train NLL %.2f KL %.2f, validation ELBO %.2f, %.0f strings/s", epoch,
                  row["beta"], row["train_nll"], row["train_kl"], row["validation_elbo"], row["strings_per_s"])
 
-    run_ = train.train(fit, val, tokens, preset, config["seed"], progress_file, chash, device, tick)
+    run_ = train.train(fit, val, tokens, preset, epochs.Session(config["seed"], progress_file, chash, device, tick))
     test = {k: round(v, 4) for k, v in train.score(run_.model, train.room_strings(held, None), tokens, preset,
                                                    device).items()}
     log.info("held-out ELBO of the chosen epoch (%d): %.2f per string", run_.best_epoch, test["elbo"])

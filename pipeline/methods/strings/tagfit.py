@@ -13,6 +13,7 @@ from ...config import config_hash
 from ...errors import InputError
 from ...graphs.data import Graph, Vocab, graphs_from_tables, vocab_of
 from ...graphs.files import split_graphs
+from ...learning import epochs
 from ...learning.checkpoint import Checkpoint
 from ...learning.device import pick_device
 from ...learning.fitted import Fitted, epoch_figure
@@ -69,8 +70,8 @@ def fit_tagger(config: dict, room_type: str, net: str, node_df: pd.DataFrame, ed
         log.info("epoch %d: loss %.3f, validation accuracy %.3f (%.3f where a triple has several clusters)", epoch,
                  row["train_loss"], row["validation_accuracy"], row["validation_accuracy_with_choice"])
 
-    model, history, best = tagger.train(rooms["fit"], rooms["validation"], clusters, tokens, preset, config["seed"],
-                                        progress_file, chash, pick_device(tc["device"]), tick)
+    session = epochs.Session(config["seed"], progress_file, chash, pick_device(tc["device"]), tick)
+    model, history, best = tagger.train(rooms["fit"], rooms["validation"], clusters, tokens, preset, session)
     held = {k: round(v, 4) for k, v in tagger.accuracy(model, rooms["heldout"], clusters, tokens, preset["votes"],
                                                        config["seed"]).items()}
     log.info("%s: held-out tagging accuracy %.3f over %d edges (%.3f over the %d with a choice; majority cluster %.3f)",

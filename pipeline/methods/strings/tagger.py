@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import torch
@@ -168,29 +167,25 @@ def _epoch(model, opt, examples: list[Example], tokens: TokenVocab, preset: dict
     return total / max(count, 1)
 
 
-def train(fit: list[Room], validation: list[Room], clusters: Clusters, tokens: TokenVocab, preset: dict, seed: int,
-          checkpoint: Path, config_hash: str, device: str = "cpu", progress=None):
-    """Fit the tagger; keep the epoch of the best validation accuracy (voted over ``preset['votes']`` strings).
-    Returns the model (best epoch), the history and the best epoch."""
-    torch.manual_seed(seed)
-    model = build_model(tokens, clusters.size, preset).to(device)
+def train(fit: list[Room], validation: list[Room], clusters: Clusters, tokens: TokenVocab, preset: dict,
+          session: epochs.Session):
+    """Fit the tagger; keep the epoch of the best validation accuracy (voted over ``preset['votes']`` strings;
+    :func:`~pipeline.learning.epochs.fit`). Returns the model (best epoch), the history and the best epoch."""
+    torch.manual_seed(session.seed)
+    model = build_model(tokens, clusters.size, preset).to(session.device)
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
-    state = epochs.resume(model, opt, checkpoint, PROGRESS, config_hash, device)
-    while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
-        epoch = state["epoch"] + 1
+
+    def epoch(n: int, best: float) -> tuple[dict, float, bool]:
         start = time.perf_counter()
-        rng = rng_for(seed, epoch)
+        rng = rng_for(session.seed, n)
         examples = [example(r, clusters, rng) for r in fit for _ in range(preset["strings_per_room"])]
-        loss = _epoch(model, opt, examples, tokens, preset, seed, epoch, device)
+        loss = _epoch(model, opt, examples, tokens, preset, session.seed, n, session.device)
         seconds = time.perf_counter() - start
-        val = accuracy(model.cpu(), validation, clusters, tokens, preset["votes"], seed)
-        model.to(device)
-        row = {"epoch": epoch, "train_loss": loss, "validation_accuracy": val["accuracy"],
+        val = accuracy(model.cpu(), validation, clusters, tokens, preset["votes"], session.seed)
+        model.to(session.device)
+        row = {"epoch": n, "train_loss": loss, "validation_accuracy": val["accuracy"],
                "validation_accuracy_with_choice": val["accuracy_with_choice"], "seconds": seconds}
-        epochs.record(state, model, opt, row, -val["accuracy"], -val["accuracy"] < state["best"], checkpoint,
-                      PROGRESS, config_hash)
-        if progress:
-            progress(epoch, row)
-    if state["best_state"] is not None:
-        model.load_state_dict(state["best_state"])
-    return model.cpu(), state["history"], state["best_epoch"] or state["epoch"]
+        return row, -val["accuracy"], -val["accuracy"] < best
+
+    run = epochs.fit(model, opt, session, PROGRESS, preset, epoch)
+    return run.model.cpu(), run.history, run.best_epoch

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import torch
@@ -27,12 +25,7 @@ Room = tuple[StringGraph, int]  # a room's graph as strings see it, and its arch
 Text = tuple[str, int]  # a room string and its forced tokens (the architecture's prefix and ".")
 
 
-@dataclass
-class Run:
-    model: SeqVAE
-    history: list[dict]
-    best_epoch: int
-    resumed_from: int
+Run = epochs.Run
 
 
 def build_model(vocab: TokenVocab, preset: dict) -> SeqVAE:
@@ -97,30 +90,25 @@ def score(model: SeqVAE, strings: list[Text], vocab: TokenVocab, preset: dict, d
     return {"nll": nll_sum / n, "kl": kl_sum / n, "elbo": (nll_sum + kl_sum) / n}
 
 
-def train(fit: list[Room], validation: list[Room], vocab: TokenVocab, preset: dict, seed: int, checkpoint: Path,
-          config_hash: str, device: str = "cpu", progress=None) -> Run:
-    """Fit the VAE on ``fit`` rooms' strings; keep the epoch of the best validation ELBO (see the module)."""
-    torch.manual_seed(seed)
-    model = build_model(vocab, preset).to(device)
+def train(fit: list[Room], validation: list[Room], vocab: TokenVocab, preset: dict, session: epochs.Session) -> Run:
+    """Fit the VAE on ``fit`` rooms' strings; keep the epoch of the best validation ELBO (see the module;
+    :func:`~pipeline.learning.epochs.fit`)."""
+    torch.manual_seed(session.seed)
+    model = build_model(vocab, preset).to(session.device)
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
-    state = epochs.resume(model, opt, checkpoint, PROGRESS, config_hash, device)
-    resumed, val_strings = state["epoch"], room_strings(validation, None)
-    while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
-        epoch = state["epoch"] + 1
-        beta = min(1.0, epoch / max(preset["kl_anneal"], 1))
+    val_strings = room_strings(validation, None)
+
+    def epoch(n: int, best: float) -> tuple[dict, float, bool | None]:
+        beta = min(1.0, n / max(preset["kl_anneal"], 1))
         start = time.perf_counter()
         model.train()
-        strings = room_strings(fit, rng_for(seed, epoch), preset["strings_per_room"])
-        nll, kl = _epoch(model, opt, strings, vocab, preset, beta, seed, epoch, device)
+        strings = room_strings(fit, rng_for(session.seed, n), preset["strings_per_room"])
+        nll, kl = _epoch(model, opt, strings, vocab, preset, beta, session.seed, n, session.device)
         seconds = time.perf_counter() - start
-        val = score(model, val_strings, vocab, preset, device)
-        row = {"epoch": epoch, "beta": beta, "train_nll": nll, "train_kl": kl, "validation_nll": val["nll"],
+        val = score(model, val_strings, vocab, preset, session.device)
+        row = {"epoch": n, "beta": beta, "train_nll": nll, "train_kl": kl, "validation_nll": val["nll"],
                "validation_kl": val["kl"], "validation_elbo": val["elbo"], "seconds": seconds,
                "strings_per_s": len(strings) / max(seconds, 1e-9)}
-        gain = val["elbo"] < state["best"] if beta >= 1.0 else None  # scores compare once the KL weight is 1
-        epochs.record(state, model, opt, row, val["elbo"], gain, checkpoint, PROGRESS, config_hash)
-        if progress:
-            progress(epoch, row)
-    if state["best_state"] is not None:
-        model.load_state_dict(state["best_state"])
-    return Run(model, state["history"], state["best_epoch"] or state["epoch"], resumed)
+        return row, val["elbo"], (val["elbo"] < best if beta >= 1.0 else None)  # scores compare once the KL weight is 1
+
+    return epochs.fit(model, opt, session, PROGRESS, preset, epoch)

@@ -12,6 +12,7 @@ from ....config import config_hash
 from ....graphs import checks as graph_checks
 from ....graphs.data import Graph, Vocab
 from ....graphs.files import split_graphs
+from ....learning import epochs
 from ....learning.checkpoint import Checkpoint
 from ....learning.device import pick_device
 from ....learning.fitted import Fitted
@@ -35,8 +36,8 @@ def fit_room_type(config: dict, vocab: Vocab, graphs: list[Graph], split: dict[s
     chash = config_hash({"preset": preset, "max_edges": gm["max_edges"], "heldout_fraction": gm["heldout_fraction"],
                          "validation_fraction": gm["validation_fraction"], "seed": config["seed"],
                          "room_type": room_type, "graphs": sorted(g.room_id for g in graphs)})
-    run_ = train.train(train_g, val_g, vocab, preset, gm["max_edges"], config["seed"], progress_file, chash, device,
-                       _ticker(room_type, preset))
+    session = epochs.Session(config["seed"], progress_file, chash, device, _ticker(room_type, preset))
+    run_ = train.train(train_g, val_g, vocab, preset, gm["max_edges"], session)
     test = heldout_scores(run_.model, held_g, vocab, preset, gm["max_edges"], config["seed"], device)
     log.info("held-out NLL of the chosen epoch (%d): %.2f per graph", run_.best_epoch, test["per_graph"])
     ckpt = Checkpoint(train.KIND, chash, {"model": run_.model.state_dict()}, {

@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import torch
@@ -34,13 +32,7 @@ def build_model(vocab: Vocab, preset: dict) -> GraphModel:
                       preset["message"])
 
 
-@dataclass
-class Run:
-    """What training returns: the best weights, the loss history (one row per epoch) and the settings."""
-    model: GraphModel
-    history: list[dict]
-    best_epoch: int
-    resumed_from: int
+Run = epochs.Run
 
 
 def heldout_nll(model: GraphModel, graphs: list[Graph], vocab: Vocab, seed: int, max_edges: int, batch_size: int,
@@ -77,31 +69,26 @@ def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) ->
     return total / max(len(seqs), 1), dropped
 
 
-def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, preset: dict, max_edges: int, seed: int,
-          checkpoint: Path, config_hash: str, device: str = "cpu", progress=None) -> Run:
+def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, preset: dict, max_edges: int,
+          session: epochs.Session) -> Run:
     """Fit ``train_graphs`` until the ``validation`` NLL has not improved by ``preset['min_improvement']``
     (relative) for ``preset['patience']`` epochs, or ``preset['max_epochs']``; keep the epoch of the lowest
-    validation NLL. ``progress(epoch, row)`` is called per epoch."""
-    torch.manual_seed(seed)
-    model = build_model(vocab, preset).to(device)
+    validation NLL (:func:`~pipeline.learning.epochs.fit`)."""
+    torch.manual_seed(session.seed)
+    model = build_model(vocab, preset).to(session.device)
     opt = torch.optim.Adam(model.parameters(), lr=preset["lr"])
-    state = epochs.resume(model, opt, checkpoint, PROGRESS, config_hash, device)
-    resumed = state["epoch"]
-    while state["epoch"] < preset["max_epochs"] and state["stale"] < preset["patience"]:
-        epoch = state["epoch"] + 1
+
+    def epoch(n: int, best: float) -> tuple[dict, float, bool]:
         start = time.perf_counter()
         model.train()
-        train_nll, dropped = _epoch(model, opt, train_graphs, vocab, seed, epoch, preset, max_edges, device)
+        train_nll, dropped = _epoch(model, opt, train_graphs, vocab, session.seed, n, preset, max_edges, session.device)
         seconds = time.perf_counter() - start
         model.eval()
-        val = mean_nll(heldout_nll(model, validation, vocab, seed, max_edges, preset["batch_size"], device))
-        row = {"epoch": epoch, "train_nll": train_nll, "validation_nll": val["per_graph"],
+        val = mean_nll(heldout_nll(model, validation, vocab, session.seed, max_edges, preset["batch_size"],
+                                   session.device))
+        row = {"epoch": n, "train_nll": train_nll, "validation_nll": val["per_graph"],
                **{f"validation_{k}": val[k] for k in KINDS},
                "seconds": seconds, "graphs_per_s": len(train_graphs) / max(seconds, 1e-9), "edges_dropped": dropped}
-        gain = row["validation_nll"] < state["best"] * (1 - preset["min_improvement"])
-        epochs.record(state, model, opt, row, row["validation_nll"], gain, checkpoint, PROGRESS, config_hash)
-        if progress:
-            progress(epoch, row)
-    if state["best_state"] is not None:
-        model.load_state_dict(state["best_state"])
-    return Run(model, state["history"], state["best_epoch"], resumed)
+        return row, row["validation_nll"], row["validation_nll"] < best * (1 - preset["min_improvement"])
+
+    return epochs.fit(model, opt, session, PROGRESS, preset, epoch)

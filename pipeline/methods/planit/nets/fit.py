@@ -13,6 +13,7 @@ from ....config import config_hash
 from ....errors import InputError
 from ....learning.checkpoint import Checkpoint
 from ....learning.device import pick_device
+from ....learning.epochs import Session
 from ....learning.fitted import Fitted
 from ....log import progress
 from . import train as nets_train
@@ -49,8 +50,8 @@ def fit_room_type(config: dict, room_type: str, net: str, cats: tuple, train_roo
     data = {"snap_angle": pc["snap_angle"], "none_share": pc["none_share"]}
     chash = config_hash({"preset": preset, "net": net, "seed": config["seed"], "room_type": room_type, **data,
                          "rooms": sorted(t.room.room_id for t in train_rooms), "categories": cats})
-    nets, history = nets_train.train(train_rooms, held_rooms, cats, preset, net == "cfcn", config["seed"],
-                                     progress_file, chash, device, _ticker(room_type, net, preset), data)
+    session = Session(config["seed"], progress_file, chash, device, _ticker(room_type, net, preset))
+    nets, history = nets_train.train(train_rooms, held_rooms, cats, preset, net == "cfcn", session, data)
     ckpt = Checkpoint(nets_train.KIND, chash, {"nets": [n.cpu().state_dict() for n in nets]}, {
         "room_type": room_type, "net": net, "categories": list(cats), "preset": preset, "heldout_ids": held_ids, **data})
     frame = pd.DataFrame(history)
