@@ -147,16 +147,17 @@ def accuracy(model: EdgeTagger, rooms: list[Room], clusters: Clusters, tokens: T
             "accuracy_with_choice": hit_multi / max(n_multi, 1), "majority_with_choice": major / max(n_multi, 1)}
 
 
-def _epoch(model, opt, examples: list[Example], tokens: TokenVocab, preset: dict, seed: int, epoch: int,
-           device: str) -> float:
-    """One pass in random batches; the mean cross-entropy per tagged edge."""
-    gen = torch.Generator().manual_seed(int(seed) * 100_019 + epoch)
+def _epoch(learner: tuple, examples: list[Example], tokens: TokenVocab, preset: dict, session: epochs.Session,
+           epoch: int) -> float:
+    """One pass of ``learner`` (model, optimiser) in random batches; the mean cross-entropy per tagged edge."""
+    model, opt = learner
+    gen = torch.Generator().manual_seed(int(session.seed) * 100_019 + epoch)
     order = torch.randperm(len(examples), generator=gen).tolist()
     total = count = 0.0
     model.train()
     for k in range(0, len(order), preset["batch_size"]):
         x, lengths, row, pos, code, lo, hi, y = _batch([examples[i] for i in order[k:k + preset["batch_size"]]],
-                                                       tokens, device)
+                                                       tokens, session.device)
         if not len(row):
             continue
         loss = nn.functional.cross_entropy(model(x, lengths, row, pos, code, lo, hi), y, reduction="sum")
@@ -179,7 +180,7 @@ def train(fit: list[Room], validation: list[Room], clusters: Clusters, tokens: T
         start = time.perf_counter()
         rng = rng_for(session.seed, n)
         examples = [example(r, clusters, rng) for r in fit for _ in range(preset["strings_per_room"])]
-        loss = _epoch(model, opt, examples, tokens, preset, session.seed, n, session.device)
+        loss = _epoch((model, opt), examples, tokens, preset, session, n)
         seconds = time.perf_counter() - start
         val = accuracy(model.cpu(), validation, clusters, tokens, preset["votes"], session.seed)
         model.to(session.device)

@@ -56,14 +56,16 @@ def _word_dropout(x: torch.Tensor, vocab: TokenVocab, rate: float, gen: torch.Ge
     return inputs.masked_fill(drop, vocab.index[UNK])
 
 
-def _epoch(model, opt, strings: list[Text], vocab: TokenVocab, preset: dict, beta: float, seed: int, epoch: int,
-           device: str) -> tuple[float, float]:
-    """One pass over ``strings`` in random batches; the mean reconstruction NLL and KL per string."""
-    gen = torch.Generator().manual_seed(int(seed) * 100_003 + epoch)
+def _epoch(learner: tuple, strings: list[Text], vocab: TokenVocab, preset: dict, beta: float, session: epochs.Session,
+           epoch: int) -> tuple[float, float]:
+    """One pass of ``learner`` (model, optimiser) over ``strings`` in random batches; the mean reconstruction NLL and
+    KL per string."""
+    model, opt = learner
+    gen = torch.Generator().manual_seed(int(session.seed) * 100_003 + epoch)
     order = torch.randperm(len(strings), generator=gen).tolist()
     nll_sum = kl_sum = 0.0
     for k in range(0, len(order), preset["batch_size"]):
-        x, lengths, forced = _tensors([strings[i] for i in order[k:k + preset["batch_size"]]], vocab, preset, device)
+        x, lengths, forced = _tensors([strings[i] for i in order[k:k + preset["batch_size"]]], vocab, preset, session.device)
         noise = torch.randn(len(x), preset["latent"], generator=gen)
         logits, mu, logvar = model(x, lengths, _word_dropout(x, vocab, preset["word_dropout"], gen), noise)
         nll, kl = losses(logits, x, mu, logvar, forced)
@@ -103,7 +105,7 @@ def train(fit: list[Room], validation: list[Room], vocab: TokenVocab, preset: di
         start = time.perf_counter()
         model.train()
         strings = room_strings(fit, rng_for(session.seed, n), preset["strings_per_room"])
-        nll, kl = _epoch(model, opt, strings, vocab, preset, beta, session.seed, n, session.device)
+        nll, kl = _epoch((model, opt), strings, vocab, preset, beta, session, n)
         seconds = time.perf_counter() - start
         val = score(model, val_strings, vocab, preset, session.device)
         row = {"epoch": n, "beta": beta, "train_nll": nll, "train_kl": kl, "validation_nll": val["nll"],

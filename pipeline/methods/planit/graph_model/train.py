@@ -52,15 +52,18 @@ def mean_nll(nll: np.ndarray) -> dict:
     return {"per_graph": float(nll.sum(1).mean()), **{k: float(nll[:, i].mean()) for i, k in enumerate(KINDS)}}
 
 
-def _epoch(model, opt, graphs, vocab, seed, epoch, preset, max_edges, device) -> tuple[float, int]:
-    """One pass over the training graphs in batches; returns the mean NLL per graph and edges dropped."""
-    rng = rng_for(seed, epoch)
+def _epoch(learner: tuple, graphs: list[Graph], vocab: Vocab, preset: dict, max_edges: int, session: epochs.Session,
+           epoch: int) -> tuple[float, int]:
+    """One pass of ``learner`` (model, optimiser) over the training graphs in batches; returns the mean NLL per graph
+    and edges dropped."""
+    model, opt = learner
+    rng = rng_for(session.seed, epoch)
     order = rng.permutation(len(graphs))
     seqs = [sequence(graphs[i], rng, max_edges) for i in order]
     total, dropped = 0.0, sum(s.dropped for s in seqs)
     for k in range(0, len(seqs), preset["batch_size"]):
         part = seqs[k:k + preset["batch_size"]]
-        loss = nll(model, make_batch(part, vocab, device)).sum(1)
+        loss = nll(model, make_batch(part, vocab, session.device)).sum(1)
         opt.zero_grad()
         loss.mean().backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), preset["clip"])
@@ -81,7 +84,7 @@ def train(train_graphs: list[Graph], validation: list[Graph], vocab: Vocab, pres
     def epoch(n: int, best: float) -> tuple[dict, float, bool]:
         start = time.perf_counter()
         model.train()
-        train_nll, dropped = _epoch(model, opt, train_graphs, vocab, session.seed, n, preset, max_edges, session.device)
+        train_nll, dropped = _epoch((model, opt), train_graphs, vocab, preset, max_edges, session, n)
         seconds = time.perf_counter() - start
         model.eval()
         val = mean_nll(heldout_nll(model, validation, vocab, session.seed, max_edges, preset["batch_size"],
