@@ -19,6 +19,7 @@ import torch
 
 from pipeline import config as config_mod
 from pipeline.graphs import checks as graph_checks, data as graph_data
+from pipeline.graphs.checks import GraphRules
 from pipeline.graphs.files import room_graphs
 from pipeline.methods.planit.graph_model import sampler, train
 from pipeline.methods.planit.graph_model.teacher import make_batch, nll
@@ -44,7 +45,8 @@ def sample_times(model, vocab, archs, seen, batch: int, repeats: int) -> list[fl
     for k in range(repeats):
         part = [archs[(k * batch + i) % len(archs)] for i in range(batch)]
         t = time.perf_counter()
-        sampler.sample(model, vocab, part, seed=k, temperature=1.0, max_objects=25, max_edges=10, seen=seen)
+        sampler.sample(model, vocab, part, seed=k, temperature=1.0,
+                       limits=sampler.Limits(25, 10, GraphRules(frozenset(seen))))
         out.append((time.perf_counter() - t) / batch)
     return out
 

@@ -16,6 +16,7 @@ from pipeline.graphs import (
     checks as graph_checks,  # noqa: E402
     data as graph_data,  # noqa: E402
 )
+from pipeline.graphs.checks import GraphRules  # noqa: E402
 from pipeline.graphs.data import OBJECT_EDGES, Graph  # noqa: E402
 from pipeline.learning.epochs import Session  # noqa: E402
 from pipeline.methods.planit.graph_model import (
@@ -57,7 +58,7 @@ def test_real_graphs_pass_the_validity_checks(bedrooms):
     _, graphs = bedrooms
     seen = graph_checks.seen_triples(graphs)
     assert all(not graph_checks.problems(g.node_class.tolist(), g.role.tolist(), [tuple(e) for e in g.edges.tolist()],
-                                         g.n_arch, seen) for g in graphs)
+                                         g.n_arch, GraphRules(frozenset(seen))) for g in graphs)
 
 
 def test_invalid_graphs_are_named():
@@ -66,11 +67,11 @@ def test_invalid_graphs_are_named():
     sup, left = OBJECT_EDGES.index("support"), OBJECT_EDGES.index("left/adjacent")
     wall = OBJECT_EDGES.index("front/adjacent")
     ok = [(0, 1, wall), (1, 2, left), (2, 3, sup)]
-    seen = {(cls[s], cls[t], c) for s, t, c in ok}
+    seen = GraphRules(frozenset((cls[s], cls[t], c) for s, t, c in ok))
     assert graph_checks.problems(cls, role, ok, 1, seen) == []
     assert graph_checks.problems(cls, role, ok[:2], 1, seen) == ["disconnected"]
     assert graph_checks.problems(cls[:1], role[:1], [], 1, seen) == ["empty"]  # walls alone: no room to furnish
-    assert "cyclic" in graph_checks.problems(cls, role, ok + [(3, 1, left)], 1, seen | {(5, 3, left)})
+    assert "cyclic" in graph_checks.problems(cls, role, ok + [(3, 1, left)], 1, GraphRules(seen.seen | {(5, 3, left)}))
     assert graph_checks.problems(cls, role, ok + [(3, 2, left)], 1, seen) == ["cyclic", "unseen_edge"]
     chain = graph_checks.ROLES.index("chain")
     assert graph_checks.problems(cls, [0, chain, 0, 0], ok, 1, seen) == ["inconsistent_chain"]
@@ -95,8 +96,8 @@ def test_link_rules_hold_on_the_graphs_they_are_learned_from_and_name_what_break
     assert graph_checks.link_problems(cls, ok, 1, hand) == []
     assert graph_checks.link_problems(cls, [(0, 1, wall), (0, 2, wall), (2, 3, sup)], 1, hand) == ["missing_link"]
     assert graph_checks.link_problems(cls + [5], ok + [(2, 4, sup)], 1, hand) == ["excess_link"]
-    assert graph_checks.problems(cls + [5], [0] * 5, ok + [(2, 4, sup)], 1, {(a, b, c) for a, b, c in
-                                 [(0, 3, wall), (3, 4, left), (4, 5, sup)]}, links=hand) == ["excess_link"]
+    assert graph_checks.problems(cls + [5], [0] * 5, ok + [(2, 4, sup)], 1, GraphRules(
+        frozenset([(0, 3, wall), (3, 4, left), (4, 5, sup)]), links=hand)) == ["excess_link"]
     assert graph_checks.link_problems(cls + [5], ok + [(2, 4, sup)], 1, graph_checks.learn_links([], 0.0)) == []
 
 
@@ -117,7 +118,7 @@ def test_tiny_model_overfits_a_graph_and_greedy_sampling_reproduces_it(bedrooms,
     g = bed_lamp_graph(graphs[0], vocab)
     run = train.train([g], [g], vocab, {**TINY, "max_epochs": 120, "patience": 120}, 10, Session(0, tmp_path / "ck.pt", "h"))
     assert run.history[-1]["validation_nll"] < 0.05 * run.history[0]["validation_nll"]
-    out = sampler.sample(run.model, vocab, [g], seed=0, temperature=0.0, max_objects=25, max_edges=10)[0]
+    out = sampler.sample(run.model, vocab, [g], seed=0, temperature=0.0, limits=sampler.Limits(25, 10))[0]
     assert same_graph(out.node_class, out.edges, g)
 
 
@@ -144,15 +145,15 @@ def model(bedrooms, tmp_path_factory):
 
 def test_sampling_with_a_seed_is_deterministic(bedrooms, model):
     vocab, graphs = bedrooms
-    runs = [sampler.sample(model, vocab, graphs[:4], seed=s, temperature=1.0, max_objects=25, max_edges=10) for s in (5, 5, 6)]
+    runs = [sampler.sample(model, vocab, graphs[:4], seed=s, temperature=1.0, limits=sampler.Limits(25, 10)) for s in (5, 5, 6)]
     key = lambda gs: [(g.node_class, g.edges) for g in gs]  # noqa: E731
     assert key(runs[0]) == key(runs[1]) and key(runs[0]) != key(runs[2])
 
 
 def test_sampling_never_proposes_unseen_cyclic_or_second_parent_edges(bedrooms, model):
     vocab, graphs = bedrooms
-    seen = graph_checks.seen_triples(graphs)
-    out = sampler.sample(model, vocab, graphs * 4, seed=1, temperature=1.5, max_objects=25, max_edges=10, seen=seen)
+    seen = GraphRules(frozenset(graph_checks.seen_triples(graphs)))
+    out = sampler.sample(model, vocab, graphs * 4, seed=1, temperature=1.5, limits=sampler.Limits(25, 10, seen))
     for g in out:
         reasons = graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch, seen)
         assert "unseen_edge" not in reasons and "cyclic" not in reasons
@@ -177,7 +178,7 @@ def test_completion_keeps_every_given_node_and_edge(bedrooms, model, tmp_path):
     (tmp_path / "spec.yaml").write_text(SPEC)
     plan, arch = spec.load_spec(tmp_path / "spec.yaml", "bedroom", vocab)
     assert arch is None and len(plan.objects) == 3
-    out = sampler.sample(model, vocab, graphs[:5], seed=2, temperature=1.0, max_objects=25, max_edges=10,
+    out = sampler.sample(model, vocab, graphs[:5], seed=2, temperature=1.0, limits=sampler.Limits(25, 10),
                          plans=[plan] * 5)
     cls = {c: vocab.category_index(c) for c in ("bed", "nightstand", "table_lamp")}
     for g in out:
@@ -295,17 +296,21 @@ def test_count_caps_and_required_categories_keep_sampled_contents_plausible(bedr
     n_arch = len(graph_data.ARCH)
     cats = len(vocab.node_classes) - n_arch
     repeats = lambda gs: sum(len(g.node_class[g.arch.n_arch:]) != len(set(g.node_class[g.arch.n_arch:])) for g in gs)  # noqa: E731
-    free = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0, max_objects=25, max_edges=10)
-    capped = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0, max_objects=25, max_edges=10,
-                            caps=np.ones(cats, int), opposite_ok=set())
+    free = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0, limits=sampler.Limits(25, 10))
+    allowed = frozenset((a, b, c) for a in range(len(vocab.node_classes)) for b in range(len(vocab.node_classes))
+                        for c in range(graph_data.N_OBJECT_EDGES))  # every edge kind: only the caps differ
+    capped = sampler.sample(model, vocab, graphs * 4, seed=3, temperature=2.0,
+                            limits=sampler.Limits(25, 10, GraphRules(allowed, caps=np.ones(cats, int))))
     assert repeats(free) > 0 and repeats(capped) == 0
     assert not any(graph_checks.near_opposite_walls(g.node_class, g.edges) for g in capped)
     g = capped[0]
     absent = next(c for c in range(n_arch, len(vocab.node_classes)) if c not in g.node_class)
     assert "missing_required" in graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch,
-                                                       graph_checks.seen_triples(graphs), {absent})
+                                                       GraphRules(frozenset(graph_checks.seen_triples(graphs)),
+                                                                  frozenset({absent})))
     assert "missing_required" not in graph_checks.problems(g.node_class, g.role, g.edges, g.arch.n_arch,
-                                                           graph_checks.seen_triples(graphs), {g.node_class[-1]})
+                                                           GraphRules(frozenset(graph_checks.seen_triples(graphs)),
+                                                                      frozenset({g.node_class[-1]})))
 
 
 def test_every_training_graph_reads_back_from_random_strings(bedrooms):

@@ -76,7 +76,8 @@ def test_an_object_near_two_opposite_walls_is_an_invalid_plan_unless_training_gr
     opp, near, far = EDGE_CLASSES.index("wall_opposite"), OBJECT_EDGES.index("front/proximal"), OBJECT_EDGES.index("front/distant")
     classes, role = [0, 0, 0, 0, 7], [0] * 5  # four walls (0 and 2 opposite, 1 and 3 opposite), one object
     arch = [(0, 2, opp), (1, 3, opp)]
-    problems = lambda e, ok=frozenset(): checks.problems(classes, role, arch + e, 4, {(0, 7, near), (0, 7, far)}, set(), ok)  # noqa: E731
+    problems = lambda e, ok=frozenset(): checks.problems(classes, role, arch + e, 4, checks.GraphRules(
+        frozenset({(0, 7, near), (0, 7, far)}), frozenset(), frozenset(ok)))  # noqa: E731
     assert "near_opposite_walls" in problems([(0, 4, near), (2, 4, near)])
     assert "near_opposite_walls" not in problems([(0, 4, near), (1, 4, near)])  # a corner
     assert "near_opposite_walls" not in problems([(0, 4, near), (2, 4, far)])  # across the room: far from one

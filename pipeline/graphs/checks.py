@@ -15,6 +15,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 import networkx as nx
+import numpy as np
 
 from ..room.contents import wilson_lower
 from .data import EDGE_CLASSES, N_OBJECT_EDGES, OBJECT_EDGES, ROLES
@@ -33,6 +34,19 @@ class LinkRules:
     (nearly) every one of its objects has, and the most objects of a class one object links to one way."""
     required: dict[int, frozenset[Link]] = field(default_factory=dict)
     caps: dict[tuple[int, Link], int] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, eq=False)
+class GraphRules:
+    """What a generated graph keeps to, learned from the training graphs: the (anchor class, target class, object edge
+    class) triples ``seen``, the node classes every graph holds (``required``), the classes that may stand near two
+    opposite walls (``opposite_ok``), the link rules and each category's largest count in one room (``caps``
+    ``(categories,)``; None: no cap)."""
+    seen: frozenset[tuple[int, int, int]] = frozenset()
+    required: frozenset[int] = frozenset()
+    opposite_ok: frozenset[int] = frozenset()
+    links: LinkRules = field(default_factory=LinkRules)
+    caps: np.ndarray | None = None
 
 
 def node_links(node_class: list[int], edges: list[tuple[int, int, int]]) -> list[Counter[Link]]:
@@ -91,11 +105,10 @@ def seen_triples(graphs) -> set[tuple[int, int, int]]:
 
 
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
-             seen: set[tuple[int, int, int]], required: set[int] | frozenset[int] = frozenset(),
-             opposite_ok: set[int] | frozenset[int] = frozenset(), links: LinkRules = LinkRules()) -> list[str]:
-    """The rejection reasons of one graph (empty: valid). ``edges`` rows (source, target, class); ``required``: node
-    classes every graph must hold; ``opposite_ok``: node classes that may stand near two opposite walls; ``links``:
-    the training graphs' link rules (:func:`learn_links`; none by default)."""
+             rules: GraphRules) -> list[str]:
+    """The rejection reasons of one graph (empty: valid) under the training graphs' ``rules`` (their count caps are
+    the sampler's). ``edges`` rows (source, target, class)."""
+    seen, required, opposite_ok = rules.seen, rules.required, rules.opposite_ok
     out = [] if len(node_class) > n_arch else ["empty"]  # every real room holds an object
     n = len(node_class)
     undirected = nx.Graph()
@@ -115,7 +128,7 @@ def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int,
         out.append("missing_required")
     if any(node_class[k] not in opposite_ok for k in near_opposite_walls(node_class, edges)):
         out.append("near_opposite_walls")
-    return out + link_problems(node_class, edges, n_arch, links)
+    return out + link_problems(node_class, edges, n_arch, rules.links)
 
 
 def near_walls(node_class: list[int], edges: list[tuple[int, int, int]]) -> dict[int, set[int]]:

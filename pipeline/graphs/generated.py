@@ -106,6 +106,15 @@ def link_rules(train: list, cfg: dict) -> graph_checks.LinkRules:
     return graph_checks.learn_links(train, cfg["required_share"], cfg["links"] == "all")
 
 
+def graph_rules(train: list, vocab, cfg: dict) -> graph_checks.GraphRules:
+    """Everything a sampled graph keeps to, from the training graphs (``cfg``: ``graph_model.sample.contents``): seen
+    edge triples, required classes and count caps (:func:`contents_of`), the classes seen near two opposite walls and
+    the link rules (:func:`link_rules`)."""
+    caps, required = contents_of(train, vocab, cfg)
+    return graph_checks.GraphRules(frozenset(graph_checks.seen_triples(train)), frozenset(required),
+                                   frozenset(graph_checks.opposite_classes(train)), link_rules(train, cfg), caps)
+
+
 def resample(n: int, budget: int, batch_size: int, base_seed: int, draw: Callable, desc: str) -> tuple[dict, int, Counter]:
     """``n`` graphs drawn in batches, each rejected one drawn again up to ``budget`` times: graph index -> (valid
     graph, seed), how many were valid at the first try, rejections by reason. ``draw(part, seed)`` gives a graph and

@@ -14,7 +14,7 @@ import torch
 from ...errors import InputError
 from ...graphs import checks as graph_checks
 from ...graphs.data import ARCH, Graph, Vocab
-from ...graphs.generated import Grown, contents_of, graph_rows, link_rules, resample
+from ...graphs.generated import Grown, graph_rows, graph_rules, resample
 from ...learning import checkpoint
 from ...seeding import seed_of
 from . import sample as decoding, train
@@ -43,10 +43,8 @@ class Rules:
 
     def __init__(self, train_graphs: list[Graph], vocab: Vocab, detail: str, contents: dict):
         self.grammar: Grammar = learn_grammar([string_graph(g, vocab) for g in train_graphs], detail)
-        self.seen = graph_checks.seen_triples(train_graphs)
-        self.caps, self.required = contents_of(train_graphs, vocab, contents)
-        self.opposite_ok = graph_checks.opposite_classes(train_graphs)
-        self.links = link_rules(train_graphs, contents)
+        self.graph = graph_rules(train_graphs, vocab, contents)
+        self.seen, self.caps, self.required = self.graph.seen, self.graph.caps, self.graph.required
         names = vocab.node_classes
         self.seen_names = {(names[a], names[b], c) for a, b, c in self.seen}
         self.caps_by_name = {} if self.caps is None else {c: int(k) for c, k in zip(vocab.categories, self.caps)}
@@ -74,8 +72,7 @@ def to_grown(text: str, room: Graph, vocab: Vocab, rules: Rules) -> tuple[Grown 
     node = [*order, *range(n_arch, n_arch + len(names))]  # parsed atom -> node of the grown graph
     cls = [*room.node_class[:n_arch].tolist(), *(vocab.node_classes.index(n) for n in names)]
     edges = [(node[s], node[t], int(c)) for s, t, c in sg.edges.tolist()]
-    bad = graph_checks.problems(cls, [0] * len(cls), edges, n_arch, rules.seen, rules.required, rules.opposite_ok,
-                                rules.links)
+    bad = graph_checks.problems(cls, [0] * len(cls), edges, n_arch, rules.graph)
     counts = np.bincount(np.array(cls[n_arch:], int) - len(ARCH), minlength=len(vocab.categories))
     if rules.caps is not None and (counts[:len(rules.caps)] > rules.caps).any():
         bad.append("excess_contents")

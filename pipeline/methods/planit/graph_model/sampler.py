@@ -15,6 +15,7 @@ import torch
 import torch.nn.functional as F
 
 from ....graphs import checks as graph_checks
+from ....graphs.checks import GraphRules
 from ....graphs.data import ARCH, N_OBJECT_EDGES, ROLES, Graph, Vocab, features, node_features
 from ....graphs.generated import Grown
 from .model import EDGE_CHOICES, GraphModel
@@ -27,6 +28,16 @@ class Plan:
     order, and edges ``(object k, direction, type, object j)``, k < j: direction 0 is k -> j."""
     objects: list[tuple[int, int | None, int | None]] = field(default_factory=list)
     edges: list[tuple[int, int, int, int]] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What a sampled graph may hold: at most ``max_objects`` objects and ``max_edges`` edges per new object, and,
+    with ``rules`` (:class:`~pipeline.graphs.checks.GraphRules`), only edges of seen kinds, no category beyond its
+    cap, no object outside ``rules.opposite_ok`` near two opposite walls."""
+    max_objects: int
+    max_edges: int
+    rules: GraphRules | None = None
 
 
 @functools.lru_cache(maxsize=8)
@@ -109,19 +120,19 @@ class _State:
 
 
 @torch.no_grad()
-def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, temperature: float, max_objects: int,
-           max_edges: int, plans: list[Plan] | None = None, seen: set | None = None,
-           caps: np.ndarray | None = None, opposite_ok: set | None = None) -> list[Grown]:
-    """One graph per architecture in ``archs`` (only their architecture is used), grown in one batch. With ``seen``
-    (anchor class, target class, type) triples, edges of unseen kinds are never proposed; with ``caps``
-    ``(categories,)`` (each category's largest count in a training room), no category is chosen once a graph holds
-    that many (a plan's forced objects may exceed it); edges that would close a cycle among objects or give an object
-    a second support parent never are; with ``opposite_ok`` (node classes), no object outside it is put adjacent or
-    proximal to two opposite walls; and every new object takes at least one edge when it can (as in training, where
-    each object touches a node before it)."""
+def sample(model: GraphModel, vocab: Vocab, archs: list[Graph], seed: int, temperature: float, limits: Limits,
+           plans: list[Plan] | None = None) -> list[Grown]:
+    """One graph per architecture in ``archs`` (only their architecture is used), grown in one batch. With the
+    ``limits``' rules, edges of unseen (anchor class, target class, type) triples are never proposed, no category is
+    chosen once a graph holds its cap (a plan's forced objects may exceed it), no object outside the rules'
+    ``opposite_ok`` classes is put adjacent or proximal to two opposite walls; edges that would close a cycle among
+    objects or give an object a second support parent never are; and every new object takes at least one edge when
+    it can (as in training, where each object touches a node before it)."""
     gen = torch.Generator().manual_seed(int(seed))
-    st = _State(model, archs, vocab, allowed_tensor(seen, len(vocab.node_classes)) if seen is not None else None,
-                opposite_ok)
+    rules, max_objects, max_edges = limits.rules, limits.max_objects, limits.max_edges
+    st = _State(model, archs, vocab, None if rules is None else allowed_tensor(set(rules.seen), len(vocab.node_classes)),
+                None if rules is None else set(rules.opposite_ok))
+    caps = None if rules is None else rules.caps
     plans = plans or [Plan() for _ in archs]
     n_objects = [0] * len(archs)
     counts = torch.zeros(len(archs), model.categories, dtype=torch.long)
