@@ -15,6 +15,7 @@ from pipeline import config as config_mod
 from pipeline.evaluation.distributions import category_kl
 from pipeline.graphs.data import ARCH
 from pipeline.graphs.files import room_graphs
+from pipeline.methods.interface import GraphRequest
 from pipeline.methods.planit.graph_model.sample import load_model, sample_room_type
 from pipeline.room.contents import implausible, learn_contents
 
@@ -27,8 +28,9 @@ def sampled_categories(config: dict, room_type: str, count: int) -> tuple[list[l
     """Each sampled graph's object categories, and the sampling summary."""
     nodes, edges = RUN / "graphs/ingested/nodes.parquet", RUN / "graphs/ingested/edges.parquet"
     _, graphs = room_graphs(nodes, edges, room_type)
-    rows, _, summary = sample_room_type(config, RUN / f"graph_model/{room_type}/planit/model.pt", graphs, nodes, edges,
-                                        room_type, count=count, threads=2)
+    request = GraphRequest(RUN / f"graph_model/{room_type}/planit/model.pt", graphs, nodes, edges, room_type,
+                           count=count)
+    rows, _, summary = sample_room_type(config, request, threads=2)
     rooms: dict = {}
     for r in rows:
         if r["kind"] == "object":

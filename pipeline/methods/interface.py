@@ -103,15 +103,30 @@ class LayoutGenerator(Protocol):
         """Yield the task's scenes, each in one of the corpus's room architectures."""
 
 
+@dataclass(frozen=True)
+class GraphRequest:
+    """What a graph generator is asked to sample: ``count`` graphs (None: its config's number) with its ``model``
+    file, in the held-out architectures among ``graphs`` (the room type's final graphs, read from the ``nodes`` and
+    ``edges`` tables, whose architecture rows the sampled graphs copy), or completing the partial graph ``spec``;
+    scene ids ``<prefix>_<k>`` (None: the generator's own prefix)."""
+    model: Path
+    graphs: list[Graph]
+    nodes: Path
+    edges: Path
+    room_type: str
+    spec: Path | None = None
+    count: int | None = None
+    prefix: str | None = None
+
+
 class GraphGenerator(Protocol):
     def fit(self, config: dict[str, Any], vocab: Vocab, graphs: list[Graph], split: dict[str, str], room_type: str,
             progress_file: Path, threads: int = 1) -> Fitted:
         """Learn from the fit graphs (validation graphs choose when to stop); return a ``learning.fitted.Fitted``
         (typed checkpoint, history, summary, loss curves). ``progress_file`` resumes an interrupted run."""
 
-    def sample(self, config: dict[str, Any], model: Path, graphs: list[Graph], nodes: Path, edges: Path, room_type: str,
-               spec: Path | None = None, count: int | None = None, threads: int = 1,
-               prefix: str | None = None) -> tuple[list[dict[str, Any]], list[dict[str, Any]], dict[str, Any]]:
+    def sample(self, config: dict[str, Any], request: GraphRequest,
+               threads: int = 1) -> tuple[list[dict[str, Any]], list[dict[str, Any]], dict[str, Any]]:
         """Graphs in held-out rooms' architectures (or completing the partial graph ``spec``) as generated_nodes /
         generated_edges rows, and a summary of the sampling."""
 

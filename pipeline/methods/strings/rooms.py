@@ -17,6 +17,7 @@ from ...graphs.data import ARCH, Graph, Vocab
 from ...graphs.generated import Grown, graph_rows, graph_rules, resample
 from ...learning import checkpoint
 from ...seeding import seed_of
+from ..interface import GraphRequest
 from . import sample as decoding, train
 from .grammar import Grammar, learn_grammar
 from .serialize import StringError, arch_prefix, parse, string_graph
@@ -82,26 +83,26 @@ def to_grown(text: str, room: Graph, vocab: Vocab, rules: Rules) -> tuple[Grown 
     return Grown(room, cls, sym, [0] * len(cls), edges), []
 
 
-def sample_room_type(config: dict, model: Path, graphs: list[Graph], nodes: Path, edges: Path, room_type: str,
-                     spec: Path | None = None, count: int | None = None, threads: int = 1,
-                     prefix: str | None = None) -> tuple[list, list, dict]:
-    """``count`` (default ``strings.sample.graphs``) valid graphs in held-out rooms' architectures (in turn) as
-    generated_nodes / generated_edges rows, and a summary (valid before rejection, rejections by reason)."""
-    if spec is not None:
-        raise InputError(f"{spec}: the strings graph generator does not complete partial graphs (PlanIT's does)")
+def sample_room_type(config: dict, request: GraphRequest, threads: int = 1) -> tuple[list, list, dict]:
+    """The request's ``count`` (default ``strings.sample.graphs``) valid graphs in held-out rooms' architectures (in
+    turn) as generated_nodes / generated_edges rows, and a summary (valid before rejection, rejections by reason)."""
+    if request.spec is not None:
+        raise InputError(f"{request.spec}: the strings graph generator does not complete partial graphs (PlanIT's does)")
+    model, graphs, room_type = request.model, request.graphs, request.room_type
     sc = config["strings"]["sample"]
     torch.set_num_threads(threads)
     rec, vocab, tokens, net = load_model(model)
     by_id = {g.room_id: g for g in graphs}
     held = [by_id[i] for i in rec["heldout_ids"] if i in by_id]
     if not held:
-        raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain it")
+        raise InputError(f"{model}: none of its held-out rooms is in {request.nodes}; retrain it")
     rules = Rules([by_id[i] for i in rec["train_ids"] + rec["validation_ids"] if i in by_id], vocab, sc["grammar"],
                   config["graph_model"]["sample"]["contents"])
-    n = count or sc["graphs"]
+    n = request.count or sc["graphs"]
     seed = seed_of(config["seed"], room_type, "strings")
-    kept, first_try, reasons = _sample_valid(net, tokens, vocab, held, n, sc, rules, seed, room_type)
-    rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"strings_{room_type}")
+    kept, first_try, reasons = _sample_valid((net, tokens, vocab), held, n, sc, rules, (seed, room_type))
+    rows_n, rows_e = graph_rows(kept, vocab, request.nodes, request.edges, room_type,
+                                request.prefix or f"strings_{room_type}")
     summary = {"room_type": room_type, "generator": "strings", "requested": n, "written": len(kept),
                "failed_after_budget": n - len(kept), "valid_before_rejection": round(first_try / max(n, 1), 4),
                "rejections": dict(reasons), "temperature": sc["temperature"], "spec": None}
@@ -138,9 +139,14 @@ def verdicts(rows: np.ndarray, rooms: list[Graph], tokens: TokenVocab, vocab: Vo
             else to_grown(tokens.decode(row), room, vocab, rules) for r, (room, row) in enumerate(zip(rooms, rows))]
 
 
-def _sample_valid(net, tokens, vocab, held, n, sc, rules, seed, room_type) -> tuple[dict, int, Counter]:
+def _sample_valid(decoder: tuple, held: list[Graph], n: int, sc: dict, rules: Rules,
+                  seeding: tuple[int, str]) -> tuple[dict, int, Counter]:
     """Graph index -> (valid Grown, seed); how many were valid at the first try; rejections by reason
-    (:func:`verdicts`), drawn again up to the resample budget (:func:`~pipeline.graphs.generated.resample`)."""
+    (:func:`verdicts`), drawn again up to the resample budget (:func:`~pipeline.graphs.generated.resample`).
+    ``decoder``: the VAE, its token and node vocabularies; ``seeding``: the base seed and the room type."""
+    net, tokens, vocab = decoder
+    seed, room_type = seeding
+
     def draw(part: list[int], s: int) -> list:
         gen = torch.Generator().manual_seed(s)
         rooms = [held[i % len(held)] for i in part]

@@ -16,6 +16,7 @@ from ....graphs.data import ARCH
 from ....graphs.generated import graph_rows, graph_rules, resample
 from ....learning import checkpoint
 from ....seeding import seed_of
+from ...interface import GraphRequest
 from . import train
 from .sampler import Limits, sample
 from .spec import load_spec
@@ -34,13 +35,11 @@ def load_model(path: Path):
     return saved, vocab, model
 
 
-def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges: Path, room_type: str,
-                     spec: Path | None = None, count: int | None = None, threads: int = 1,
-                     prefix: str | None = None) -> tuple[list, list, dict]:
-    """``count`` (default ``graph_model.sample.graphs``) valid graphs as generated_nodes / generated_edges rows, and
-    a summary of the sampling; with ``spec``, graphs that complete that partial graph. ``graphs``: the room type's
-    final graphs (``nodes``, ``edges``: their tables, whose architecture rows the sampled graphs copy); scene ids
-    are ``<prefix>_<k>`` (default ``gen_<room type>``)."""
+def sample_room_type(config: dict, request: GraphRequest, threads: int = 1) -> tuple[list, list, dict]:
+    """The request's ``count`` (default ``graph_model.sample.graphs``) valid graphs as generated_nodes /
+    generated_edges rows, and a summary of the sampling; with its ``spec``, graphs that complete that partial graph;
+    scene ids ``<prefix>_<k>`` (default ``gen_<room type>``)."""
+    model, graphs, nodes, room_type, spec = request.model, request.graphs, request.nodes, request.room_type, request.spec
     sc = config["graph_model"]["sample"]
     torch.set_num_threads(threads)
     saved, vocab, net = load_model(model)
@@ -58,14 +57,14 @@ def sample_room_type(config: dict, model: Path, graphs: list, nodes: Path, edges
         rules = replace(rules, seen=rules.seen | _plan_triples(plan))  # what the spec asks for is allowed
     if not held:
         raise InputError(f"{model}: none of its held-out rooms is in {nodes}; retrain (snakemake --forcerun train_graph_model)")
-    n = count or sc["graphs"]
+    n = request.count or sc["graphs"]
     base_seed = seed_of(config["seed"], room_type, Path(spec).name if spec else "")
     limits = Limits(sc["max_objects"], saved["max_edges"], rules)
     draw = lambda rooms, seed: sample(net, vocab, rooms, seed, sc["temperature"], limits,
                                       [plan] * len(rooms) if plan else None)
     kept, first_try, reasons = _sample_valid(draw, held, n, sc, rules,
                                              (base_seed, room_type))
-    rows_n, rows_e = graph_rows(kept, vocab, nodes, edges, room_type, prefix or f"gen_{room_type}")
+    rows_n, rows_e = graph_rows(kept, vocab, nodes, request.edges, room_type, request.prefix or f"gen_{room_type}")
     summary = {"room_type": room_type, "requested": n, "written": len(kept), "failed_after_budget": n - len(kept),
                "valid_before_rejection": round(first_try / max(n, 1), 4), "rejections": dict(reasons),
                "temperature": sc["temperature"], "spec": Path(spec).name if spec else None}
