@@ -193,10 +193,34 @@ class BackToWall:
         return xy, float(away[np.argmin(turn_error(away - yaw))])
 
 
+class FaceAnchor:
+    """A proposer whose floor objects planned beside a placed floor anchor face it as often as the training rooms'
+    objects of their category face one of the anchor's category standing near it (``shares``: (anchor category,
+    object category) -> share, :func:`~pipeline.placement.facing.learn_anchor_facing`): with the largest share among
+    the planned anchors, the drawn turn becomes the one of that anchor's four axis turns that points most directly at
+    its centre from the drawn place (an office chair in front of its desk turns to the desk); the place stays drawn."""
+
+    def __init__(self, base, shares: dict[tuple[str, str], float]):
+        self.base, self.shares = base, shares
+
+    def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        drawn = self.base.pose(req, rng)
+        ruled = [(self.shares.get((req.room.categories[a.obj], req.category), 0.0), a.obj) for a in req.anchors
+                 if a.obj is not None and a.kind == "spatial" and not a.reverse]
+        if drawn is None or not ruled or any(a.kind == SUPPORT for a in req.anchors) or rng.random() >= max(ruled)[0]:
+            return drawn
+        xy, _ = drawn
+        anchor = req.room.boxes.reshape(-1, 7)[max(ruled)[1]]
+        to = anchor[:2] - xy
+        heading = float(np.arctan2(-to[0], to[1]))  # the yaw whose front (-sin, cos) points at the anchor's centre
+        turns = anchor[6] + np.arange(4) * np.pi / 2
+        return xy, float(turns[np.argmin(turn_error(turns - heading))])
+
+
 class FacingPartner:
     """A proposer whose floor objects face a placed object their plan says nothing of as often as the training rooms'
     objects of their category face one of that category (``shares``: (partner category, object category) -> share,
-    :func:`~pipeline.placement.partners.learn_facing_partners`): with the largest such share among the placed
+    :func:`~pipeline.placement.facing.learn_facing_partners`): with the largest such share among the placed
     partners, the pose is drawn from the base proposer conditioned on facing one of them within ``facing`` rad
     (:func:`~pipeline.geometry.function.facing_each_other`), by drawing up to ``tries`` poses and keeping the first that
     does (else the first drawn). A partner the object has a planned edge to is the plan's; an object on a support has

@@ -16,8 +16,8 @@ from ...errors import InputError
 from ...learning import checkpoint
 from ...log import progress
 from ...placement import order, proposers
+from ...placement.facing import learn_anchor_facing, learn_facing_partners
 from ...placement.layout import walls_of, with_objects
-from ...placement.partners import learn_facing_partners
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from ...placement.search import SCORED, instantiate
@@ -37,51 +37,59 @@ class PoseRules:
     """What the training rooms say about poses beyond the proposer's draw: centre-line and back-edge rules per
     (anchor, object, kind) (:func:`~pipeline.placement.support.learn_centring`) and per category the share of
     objects against a wall that have their back to it (:func:`~pipeline.placement.walls.learn_wall_backs`); per
-    (partner, object) category the share of objects facing a partner (:func:`~pipeline.placement.partners.
-    learn_facing_partners`)."""
+    (partner, object) category the share of objects facing a partner (:func:`~pipeline.placement.facing.
+    learn_facing_partners`) and of objects near an anchor facing it (:func:`~pipeline.placement.facing.
+    learn_anchor_facing`)."""
     centring: dict = field(default_factory=dict)
     wall_backs: dict = field(default_factory=dict)
     partners: dict = field(default_factory=dict)
+    anchor_facing: dict = field(default_factory=dict)
 
 
 def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRules | None = None):
     """The variant's proposer (``cfg``: its instantiate settings, ``extract``: the extraction's): the pose networks
     (their densities weighted by the relation bands when ``relation_mask``), the relative-pose prior (likewise), or
-    uniform or rule-band locations with the networks' orientations; when the variant snaps, objects planned against a
-    wall turned with their back to it (:class:`~pipeline.placement.proposers.BackToWall`), drawn facing the placed
-    objects the training rooms' objects face unplanned (:class:`~pipeline.placement.proposers.FacingPartner`), and put
-    on the centre lines
-    of their supports, planned floor anchors and the placed objects they face
-    (:class:`~pipeline.placement.proposers.Centred`) by the training rooms' ``rules``."""
+    uniform or rule-band locations with the networks' orientations; when the variant snaps, by the training rooms'
+    ``rules``, objects planned beside an anchor turned to face it (:class:`~pipeline.placement.proposers.FaceAnchor`)
+    or against a wall with their back to it (:class:`~pipeline.placement.proposers.BackToWall`), drawn facing the
+    placed objects the training rooms' objects face unplanned (:class:`~pipeline.placement.proposers.FacingPartner`),
+    and put on the centre lines of their supports, planned floor anchors and the placed objects they face
+    (:class:`~pipeline.placement.proposers.Centred`)."""
     base = location_proposer(location, saved, cfg, extract)
     if rules is None or not cfg["snap"]["enabled"]:
         return base
+    facing = np.radians(cfg["snap"]["centre_facing_angle"])
+    if rules.anchor_facing:
+        base = proposers.FaceAnchor(base, rules.anchor_facing)
     if rules.wall_backs:
         base = proposers.BackToWall(base, rules.wall_backs)
     if rules.partners:
-        snap = cfg["snap"]
-        base = proposers.FacingPartner(base, rules.partners, np.radians(snap["centre_facing_angle"]), snap["partner_tries"])
+        base = proposers.FacingPartner(base, rules.partners, facing, cfg["snap"]["partner_tries"])
     if rules.centring:
-        base = proposers.Centred(base, rules.centring, np.radians(cfg["snap"]["centre_facing_angle"]))
+        base = proposers.Centred(base, rules.centring, facing)
     return base
 
 
 def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
     """The training rooms' pose rules (``instantiate.snap``'s settings): centre lines and back edges of objects on
-    supports, beside floor anchors and facing each other, and backs to walls."""
-    snap = config["instantiate"]["snap"]
-    training = corpus.training()
+    supports, beside floor anchors and facing each other; backs to walls; facing partners and anchors."""
+    snap, floor = config["instantiate"]["snap"], config["floor_contact"]
+    training, facing = corpus.training(), np.radians(snap["centre_facing_angle"])
     window = Window(snap["centre_within"], snap["centre_min_pairs"], snap["centre_concentration"], snap["centre_fraction"])
-    centring = learn_centring(training, window, config["instantiate"]["checks"]["learned_support"]["tolerance"],
-                              config["floor_contact"], np.radians(snap["centre_facing_angle"]), snap["flush_within"])
-    wall_backs = learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
-                                  snap["centre_min_pairs"], config["floor_contact"]) if snap["wall_back_gap"] > 0 else {}
-    partners = learn_facing_partners(training, np.radians(snap["centre_facing_angle"]), snap["centre_min_pairs"],
-                                     snap["partner_min_share"], config["floor_contact"]) if snap["partner_tries"] else {}
+    rules = PoseRules(
+        learn_centring(training, window, config["instantiate"]["checks"]["learned_support"]["tolerance"], floor, facing,
+                       snap["flush_within"]),
+        learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]), snap["centre_min_pairs"],
+                         floor) if snap["wall_back_gap"] > 0 else {},
+        learn_facing_partners(training, facing, snap["centre_min_pairs"], snap["facing_min_share"], floor)
+        if snap["partner_tries"] else {},
+        learn_anchor_facing(training, snap["face_anchor_gap"], facing, snap["centre_min_pairs"], snap["facing_min_share"],
+                            floor) if snap["face_anchor_gap"] > 0 else {})
+    named = lambda rule: {"/".join(key): (tuple(v[:2]) if isinstance(v, tuple) else v) for key, v in rule.items()}
     log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s; facing "
-             "partners %s", corpus.room_type, {"/".join(key): tuple(v[:2]) for key, v in centring.items()}, wall_backs,
-             {"/".join(pair): share for pair, share in partners.items()})
-    return PoseRules(centring, wall_backs, partners)
+             "partners %s; facing anchors %s", corpus.room_type, named(rules.centring), rules.wall_backs,
+             named(rules.partners), named(rules.anchor_facing))
+    return rules
 
 
 def location_proposer(location: str, saved, cfg: dict, extract: dict):

@@ -1,0 +1,70 @@
+"""Which floor objects face an object of another category, learned from the training rooms by the predicates the
+search and the evaluation share (:mod:`pipeline.geometry.function`).
+
+Anchors (:func:`learn_anchor_facing`): a plan's "in front of the desk" edge says where an office chair stands, not
+which way it turns, and PlanIT's orientation network, which sees a crop and none of the planned relations, turned 6
+of the 8 failing chairs of a default run's offices 90-180 degrees from their desk. Per (anchor category, object
+category), the share of the training rooms' floor objects standing within a gap of a floor object of the anchor
+category that face it (:func:`~pipeline.geometry.function.facing_angles`).
+
+Partners (:func:`learn_facing_partners`), whether or not the graph joins them: a television stand faces the sofa
+across the room in every training living room, but extraction finds the sofa -> stand edge in only 76% of them (a
+coffee table hides the stand from the sofa's front in the rest), so a sampled graph often plans the stand against a
+wall and nothing more. Per (partner category, object category), the share of the training rooms' floor objects of
+the category that face an object of the partner category (:func:`~pipeline.geometry.function.facing_each_other`,
+the predicate the search's centre lines use), over the rooms that hold both on the floor."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry.boxes import on_floor
+from ..geometry.function import facing_angles, facing_each_other, plan_gaps
+from ..room import RoomInput
+
+Pair = tuple[str, str]  # (partner category, object category)
+
+
+def facing_partner_flags(room: RoomInput, facing: float, floor_contact: float) -> dict[Pair, list[bool]]:
+    """(partner category, object category) -> per floor object of the category, whether it faces some floor object
+    of the partner category within ``facing`` rad (only categories the room holds both of on the floor)."""
+    b = room.boxes.reshape(-1, 7)
+    floor = np.flatnonzero(on_floor(b, floor_contact))
+    cats = np.array([room.categories[k] for k in floor], object)
+    faces = facing_each_other(b[floor], facing)  # (partner, object)
+    out: dict[Pair, list[bool]] = {}
+    for partner in sorted(set(cats)):
+        rows = faces[cats == partner]
+        for k in range(len(floor)):
+            if (cats == partner).sum() - (cats[k] == partner) > 0:
+                out.setdefault((partner, cats[k]), []).append(bool(rows[:, k].any()))
+    return out
+
+
+def learn_facing_partners(rooms: list[RoomInput], facing: float, min_pairs: int, min_share: float,
+                          floor_contact: float) -> dict[Pair, float]:
+    """(partner category, object category) -> the share of the training floor objects of the category that face a
+    partner (:func:`facing_partner_flags`), kept where at least ``min_pairs`` objects show it and the share is at least
+    ``min_share``."""
+    seen: dict[Pair, list[bool]] = {}
+    for room in rooms:
+        for pair, flags in facing_partner_flags(room, facing, floor_contact).items():
+            seen.setdefault(pair, []).extend(flags)
+    shares = {pair: round(float(np.mean(f)), 3) for pair, f in sorted(seen.items()) if len(f) >= min_pairs}
+    return {pair: s for pair, s in shares.items() if s >= min_share}
+
+
+def learn_anchor_facing(rooms: list[RoomInput], gap: float, facing: float, min_pairs: int, min_share: float,
+                        floor_contact: float) -> dict[Pair, float]:
+    """(anchor category, object category) -> the share of the training pairs of floor objects standing within
+    ``gap`` m of each other whose object faces the anchor within ``facing`` rad (literal fronts), where at least
+    ``min_pairs`` pairs show it and the share is at least ``min_share``."""
+    seen: dict[Pair, list[bool]] = {}
+    for room in rooms:
+        b = room.boxes.reshape(-1, 7)
+        floor = np.flatnonzero(on_floor(b, floor_contact))
+        near, faces = plan_gaps(b[floor]) <= gap, facing_angles(b[floor]) <= facing  # (anchor, object)
+        np.fill_diagonal(near, False)
+        for a, t in zip(*np.nonzero(near)):
+            seen.setdefault((room.categories[floor[a]], room.categories[floor[t]]), []).append(bool(faces[a, t]))
+    shares = {pair: round(float(np.mean(f)), 3) for pair, f in sorted(seen.items()) if len(f) >= min_pairs}
+    return {pair: s for pair, s in shares.items() if s >= min_share}
