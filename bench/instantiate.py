@@ -34,6 +34,7 @@ from pipeline.evaluation.evaluate import off_axis_gap, off_axis_shares
 from pipeline.geometry.frames import turn_error
 from pipeline.learning import checkpoint
 from pipeline.methods.corpus import load_corpus
+from pipeline.methods.interface import RoomTypeRows
 from pipeline.methods.placing import load_context
 from pipeline.methods.planit import layout as instantiate
 from pipeline.methods.planit.nets.fit import training_rooms
@@ -62,7 +63,7 @@ def probe_networks(cfg, room_type: str, saved, probes: int, checker) -> dict:
     flt = [("room_type", "=", room_type)]
     nodes = tables.read(Path("results/graphs/ingested/nodes.parquet"), "final_nodes", filters=flt).to_pandas()
     edges = tables.read(Path("results/graphs/ingested/edges.parquet"), "final_edges", filters=flt).to_pandas()
-    _, _, held, _ = training_rooms(corpus.inputs, nodes, edges, corpus.split)
+    held = training_rooms(RoomTypeRows(nodes, edges, corpus.inputs, corpus.split)).held
     net, rng = NetProposer(saved, cfg["instantiate"]["density_cache"]), np.random.default_rng(0)
     near, net_hits, rule_hits, n = [], 0, 0, 0
     for t in (held[int(rng.integers(len(held)))] for _ in range(probes)):

@@ -21,6 +21,7 @@ sys.path.insert(0, str(ROOT))
 
 from pipeline import config as config_mod, tables  # noqa: E402
 from pipeline.graphs.files import read_split  # noqa: E402
+from pipeline.methods.interface import RoomTypeRows  # noqa: E402
 from pipeline.methods.strings.tagfit import fit_tagger  # noqa: E402
 from pipeline.room import load_rooms  # noqa: E402
 
@@ -50,7 +51,7 @@ def main() -> None:
             c["strings"]["tagger"]["bandwidth"] = {k: v * scale if k != "angle" else min(v * scale, 180)
                                                    for k, v in cfg["strings"]["tagger"]["bandwidth"].items()}
             with tempfile.TemporaryDirectory() as tmp:
-                fitted = fit_tagger(c, room_type, "tagger", node_df, edge_df, inputs, split, Path(tmp) / "p.pt")
+                fitted = fit_tagger(c, room_type, "tagger", RoomTypeRows(node_df, edge_df, inputs, split), Path(tmp) / "p.pt")
             s, h = fitted.summary, fitted.summary["heldout"]
             best = fitted.history.loc[fitted.history["epoch"] == s["best_epoch"]].iloc[0]
             print(f"| {room_type} | {scale:g} | {s['clusters']} | {s['triples_with_choice']} of {s['triples']} | "

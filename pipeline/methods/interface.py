@@ -119,6 +119,16 @@ class GraphRequest:
     prefix: str | None = None
 
 
+@dataclass(frozen=True)
+class RoomTypeRows:
+    """What a placement learner reads of one room type: its final graph rows (``nodes`` and ``edges`` frames), its
+    graphed rooms (``rooms``: room id -> RoomInput) and its ``split`` (room id -> fit | validation | heldout)."""
+    nodes: pd.DataFrame
+    edges: pd.DataFrame
+    rooms: dict[str, RoomInput]
+    split: dict[str, str]
+
+
 class GraphGenerator(Protocol):
     def fit(self, config: dict[str, Any], vocab: Vocab, graphs: list[Graph], split: dict[str, str], room_type: str,
             progress_file: Path, threads: int = 1) -> Fitted:
@@ -150,8 +160,8 @@ class GraphSource:
 @dataclass(frozen=True)
 class PlacementLearner:
     """A registered learner of placement (rule ``train_placement``, its ``net`` wildcard): ``fit``
-    (``"module:function"``) is ``fit(config, room_type, net, node_df, edge_df, inputs, split, progress_file, threads)``
-    over one room type's final graph rows and rooms (room id -> RoomInput), returning a ``learning.fitted.Fitted``;
+    (``"module:function"``) is ``fit(config, room_type, net, data, progress_file, threads)`` over one room type's
+    :class:`RoomTypeRows` ``data``, returning a ``learning.fitted.Fitted``;
     ``train_keys(config)``: the dotted config keys it reads."""
     name: str
     fit: str

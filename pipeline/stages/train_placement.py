@@ -10,10 +10,11 @@ from ..stage import Files
 def run(config: dict, inp: Files, out: Files, room_type: str, net: str, threads: int = 1) -> dict:
     from .. import methods
     from ..learning.fitted import write_fitted
+    from ..methods.interface import RoomTypeRows
 
     fit = methods.placement_fit(net)
     node_df, edge_df, rooms = graphs_and_rooms(inp.nodes, inp.edges, inp.rooms, inp.architecture, inp.objects,
                                                room_type)
-    fitted = fit(config, room_type, net, node_df, edge_df, rooms, read_split(inp.split),
-                 out.model.with_name("checkpoint.pt"), threads)
+    data = RoomTypeRows(node_df, edge_df, rooms, read_split(inp.split))
+    fitted = fit(config, room_type, net, data, out.model.with_name("checkpoint.pt"), threads)
     return write_fitted(out, fitted)

@@ -16,6 +16,7 @@ from ...learning.device import pick_device
 from ...learning.fitted import Fitted, epoch_figure
 from ...log import progress
 from ...room import RoomInput
+from ..interface import RoomTypeRows
 from . import train
 from .hierarchy import Node, build_tree, leaves, to_dict, tree_depth
 
@@ -36,9 +37,10 @@ def room_trees(node_df: pd.DataFrame, inputs: dict[str, RoomInput], ids: list[st
     return out
 
 
-def fit_grains(config: dict, room_type: str, net: str, node_df: pd.DataFrame, edge_df: pd.DataFrame,
-               inputs: dict[str, RoomInput], split: dict[str, str], progress_file: Path, threads: int = 1) -> Fitted:
+def fit_grains(config: dict, room_type: str, net: str, data: RoomTypeRows, progress_file: Path,
+               threads: int = 1) -> Fitted:
     """Train on the fit rooms' trees until the validation loss stops improving; resumes from ``progress_file``."""
+    node_df, inputs, split = data.nodes, data.rooms, data.split
     gc = config["grains"]
     preset = gc["presets"][gc["preset"]]
     torch.set_num_threads(threads)

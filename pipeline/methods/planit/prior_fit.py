@@ -14,12 +14,14 @@ from ...errors import InputError
 from ...learning.checkpoint import Checkpoint
 from ...learning.fitted import Fitted
 from ...placement.prior import KIND, learn_prior
+from ..interface import RoomTypeRows
 from .nets.data import training_room
 
 
-def fit_prior(config: dict, room_type: str, net: str, node_df: pd.DataFrame, edge_df: pd.DataFrame, inputs: dict,
-              split: dict[str, str], progress_file: Path, threads: int = 1) -> Fitted:
+def fit_prior(config: dict, room_type: str, net: str, data: RoomTypeRows, progress_file: Path,
+              threads: int = 1) -> Fitted:
     """The prior of ``room_type`` from its fit rooms (room id -> RoomInput ``inputs``) and final graph rows."""
+    node_df, edge_df, inputs, split = data.nodes, data.edges, data.rooms, data.split
     cfg = config["placement"]["prior"]
     ids = sorted(i for i in node_df["room_id"].unique() if split.get(i) == "fit" and i in inputs)
     if not ids:

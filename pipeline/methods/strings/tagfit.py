@@ -19,8 +19,8 @@ from ...learning.device import pick_device
 from ...learning.fitted import Fitted, epoch_figure
 from ...log import progress
 from ...placement.layout import walls_of
-from ...room import RoomInput
 from ...seeding import rng_for
+from ..interface import RoomTypeRows
 from . import tagger
 from .poses import Clusters, EdgePose, edge_poses, fit_clusters
 from .serialize import arch_prefix, room_string, string_graph
@@ -45,9 +45,10 @@ def token_vocab(fit: list[tagger.Room], every: list[tagger.Room], seed: int, per
                        [f"@{k}" for k in range(max((r.n_arch for r in every), default=1))])
 
 
-def fit_tagger(config: dict, room_type: str, net: str, node_df: pd.DataFrame, edge_df: pd.DataFrame,
-               inputs: dict[str, RoomInput], split: dict[str, str], progress_file: Path, threads: int = 1) -> Fitted:
+def fit_tagger(config: dict, room_type: str, net: str, data: RoomTypeRows, progress_file: Path,
+               threads: int = 1) -> Fitted:
     """Cluster the fit rooms' relative poses, train the tagger, score it on the held-out rooms."""
+    node_df, edge_df, inputs, split = data.nodes, data.edges, data.rooms, data.split
     tc = config["strings"]["tagger"]
     preset = tc["presets"][tc["preset"]]
     torch.set_num_threads(threads)

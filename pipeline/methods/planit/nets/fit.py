@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
+from typing import NamedTuple
 
 import pandas as pd
 import torch
@@ -16,6 +17,7 @@ from ....learning.device import pick_device
 from ....learning.epochs import Session
 from ....learning.fitted import Fitted
 from ....log import progress
+from ...interface import RoomTypeRows
 from . import train as nets_train
 from .data import TrainingRoom, training_room
 
@@ -24,21 +26,32 @@ NETS = ("cfcn", "fcn")
 LOGLIK = ("heldout_location_loglik", "heldout_orientation_loglik", "heldout_pose_loglik")
 
 
-def training_rooms(inputs: dict, node_df: pd.DataFrame, edge_df: pd.DataFrame, split: dict[str, str]):
-    """Categories, training and held-out :class:`TrainingRoom` lists, and the held-out ids, of one room type's
-    rooms (``inputs``: room id -> RoomInput) and final graphs."""
+class TrainingSet(NamedTuple):
+    """One room type's categories, training (fit and validation) and held-out :class:`TrainingRoom` lists, and the
+    held-out room ids."""
+    categories: tuple[str, ...]
+    train: list[TrainingRoom]
+    held: list[TrainingRoom]
+    held_ids: list[str]
+
+
+def training_rooms(data: RoomTypeRows) -> TrainingSet:
+    """The :class:`TrainingSet` of one room type's rooms and final graphs."""
+    inputs, node_df, edge_df, split = data.rooms, data.nodes, data.edges, data.split
     ids = sorted(node_df["room_id"].unique())
     train_ids = [i for i in ids if split.get(i) in ("fit", "validation")]
     held_ids = [i for i in ids if split.get(i) == "heldout"]
     cats = tuple(sorted({c for i in ids if i in inputs for c in inputs[i].categories}))
     by_room_n, by_room_e = dict(tuple(node_df.groupby("room_id"))), dict(tuple(edge_df.groupby("room_id")))
     make = lambda i: training_room(inputs[i], by_room_n[i], by_room_e.get(i, edge_df.iloc[:0]))
-    return cats, [make(i) for i in train_ids if i in inputs], [make(i) for i in held_ids if i in inputs], held_ids
+    return TrainingSet(cats, [make(i) for i in train_ids if i in inputs], [make(i) for i in held_ids if i in inputs],
+                       held_ids)
 
 
-def fit_room_type(config: dict, room_type: str, net: str, cats: tuple, train_rooms: list[TrainingRoom],
-                  held_rooms: list[TrainingRoom], held_ids: list[str], progress_file: Path, threads: int = 1) -> Fitted:
+def fit_room_type(config: dict, room_type: str, net: str, rooms: TrainingSet, progress_file: Path,
+                  threads: int = 1) -> Fitted:
     """Train for the preset's steps; ``progress_file`` resumes an interrupted run with the same settings."""
+    cats, train_rooms, held_rooms, held_ids = rooms
     if net not in NETS:
         raise InputError(f"--net: '{net}' is not one of {', '.join(NETS)}")
     if not train_rooms:
@@ -64,11 +77,10 @@ def fit_room_type(config: dict, room_type: str, net: str, cats: tuple, train_roo
     return Fitted(ckpt, frame, summary, _curve(frame, room_type, net))
 
 
-def fit_from_tables(config: dict, room_type: str, net: str, node_df: pd.DataFrame, edge_df: pd.DataFrame,
-                    inputs: dict, split: dict[str, str], progress_file: Path, threads: int = 1) -> Fitted:
+def fit_from_tables(config: dict, room_type: str, net: str, data: RoomTypeRows, progress_file: Path,
+                    threads: int = 1) -> Fitted:
     """:func:`fit_room_type` on one room type's final graph rows and rooms (the placement learners' signature)."""
-    cats, train_rooms, held_rooms, held_ids = training_rooms(inputs, node_df, edge_df, split)
-    return fit_room_type(config, room_type, net, cats, train_rooms, held_rooms, held_ids, progress_file, threads)
+    return fit_room_type(config, room_type, net, training_rooms(data), progress_file, threads)
 
 
 def _ticker(room_type: str, net: str, preset: dict):
