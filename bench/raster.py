@@ -37,7 +37,8 @@ def rooms(nodes: pd.DataFrame, limit: int) -> list[dict]:
 def rate(rs: list[dict], size: int, mpp: float) -> float:
     start = time.perf_counter()
     for r in rs:
-        raster.render_room(r["outline"], r["walls"], r["half"], {}, r["boxes"], r["category"], r["n"], size, mpp, r["centre"])
+        raster.render_room(raster.Shell(r["outline"], r["walls"], r["half"], {}), r["boxes"], r["category"], r["n"],
+                           raster.Canvas(size, mpp, r["centre"]))
     return len(rs) / (time.perf_counter() - start)
 
 

@@ -42,8 +42,8 @@ def test_render_channels_heights_orientation_and_anchor():
     boxes = np.array([[1.0, 1.0, 0.4, 0.5, 0.5, 0.4, 0.0],  # a table top at 0.8 m
                       [1.0, 1.0, 1.0, 0.1, 0.1, 0.1, math.pi / 2],  # a vase on it, turned, top at 1.1 m
                       [4.0, 1.0, 0.3, 0.3, 0.3, 0.3, math.pi]])
-    img = raster.render_room(L_ROOM, walls, np.full(len(walls), 0.075), {"doors": np.array([[[3.0, 0.0], [3.9, 0.0]]])},
-                             boxes, np.array([0, 1, 0]), 2, 64, 0.1, (2.5, 2.0), anchor=2)
+    shell = raster.Shell(L_ROOM, walls, np.full(len(walls), 0.075), {"doors": np.array([[[3.0, 0.0], [3.9, 0.0]]])})
+    img = raster.render_room(shell, boxes, np.array([0, 1, 0]), 2, raster.Canvas(64, 0.1, (2.5, 2.0)), anchor=2)
     assert img.shape == (len(raster.CHANNELS) + 2, 64, 64)
     row, col = lambda y: int((2.0 + 3.2 - y) / 0.1), lambda x: int((x - 2.5 + 3.2) / 0.1)  # noqa: E731
     assert img[4, row(1.0), col(1.0)] == pytest.approx(1.1) and img[4, row(1.35), col(1.35)] == pytest.approx(0.8)
@@ -57,11 +57,10 @@ def test_render_channels_heights_orientation_and_anchor():
 
 def test_a_room_larger_than_the_window_is_cropped_to_it():
     big = np.array([[0, 0], [12, 0], [12, 9], [0, 9.0]])
-    img = raster.render_room(big, polygon_segments(big), np.full(4, 0.1), {}, np.zeros((0, 7)), np.zeros(0, int), 1,
-                             64, 0.1, (6.0, 4.5))
+    shell = raster.Shell(big, polygon_segments(big), np.full(4, 0.1), {})
+    img = raster.render_room(shell, np.zeros((0, 7)), np.zeros(0, int), 1, raster.Canvas(64, 0.1, (6.0, 4.5)))
     assert img[0].all() and not img[1].any()  # all floor, no wall within 3.2 m of the centre
-    corner = raster.render_room(big, polygon_segments(big), np.full(4, 0.1), {}, np.zeros((0, 7)), np.zeros(0, int), 1,
-                                64, 0.1, (0.0, 0.0))
+    corner = raster.render_room(shell, np.zeros((0, 7)), np.zeros(0, int), 1, raster.Canvas(64, 0.1, (0.0, 0.0)))
     assert corner[0].mean() == pytest.approx(0.25, abs=0.02) and corner[1].any()
 
 

@@ -12,7 +12,7 @@ render costs a few NumPy calls per shape.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, cast
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -92,18 +92,33 @@ def segment_quads(segments: np.ndarray, half_width: ArrayLike) -> np.ndarray:
 CHANNELS = ("floor", "walls", "doors", "windows", "height", "sin_yaw", "cos_yaw", "anchor")
 
 
-def render_room(outline: np.ndarray, walls: np.ndarray, wall_half: np.ndarray, openings: dict[str, Any], boxes: np.ndarray,
-                category: np.ndarray, n_categories: int, size: int, mpp: float, centre: Sequence[float] | np.ndarray,
-                anchor: int | None = None) -> np.ndarray:
-    """``(len(CHANNELS) + n_categories, size, size)`` float32 top-down view of one room.
+class Canvas(NamedTuple):
+    """A square image of ``size`` pixels of ``mpp`` m each, centred at plan point ``centre`` (m)."""
+    size: int
+    mpp: float
+    centre: Sequence[float] | np.ndarray = (0.0, 0.0)
 
-    ``outline (k, 2)`` floor polygon; ``walls (m, 2, 2)`` segments with half thicknesses ``wall_half (m,)``;
-    ``openings`` {'doors': (d, 2, 2), 'windows': (w, 2, 2)} segments; ``boxes (n, 7)`` objects (cx, cy, cz, hx, hy,
-    hz, yaw) of categories ``category (n,)`` (index into the per-category channels). Heights are object tops (m);
-    where objects overlap, the higher one sets height and orientation. ``anchor``: an object whose footprint fills
-    the anchor channel.
+
+class Shell(NamedTuple):
+    """A room's architecture in plan: ``outline (k, 2)`` floor polygon; ``walls (m, 2, 2)`` segments with half
+    thicknesses ``wall_half (m,)``; ``openings`` {'doors': (d, 2, 2), 'windows': (w, 2, 2)} segments."""
+    outline: np.ndarray
+    walls: np.ndarray
+    wall_half: np.ndarray
+    openings: dict[str, Any]
+
+
+def render_room(shell: Shell, boxes: np.ndarray, category: np.ndarray, n_categories: int, canvas: Canvas,
+                anchor: int | None = None) -> np.ndarray:
+    """``(len(CHANNELS) + n_categories, size, size)`` float32 top-down view of one room on ``canvas``: its ``shell``
+    and objects ``boxes (n, 7)`` (cx, cy, cz, hx, hy, hz, yaw) of categories ``category (n,)`` (index into the
+    per-category channels). Heights are object tops (m); where objects overlap, the higher one sets height and
+    orientation. ``anchor``: an object whose footprint fills the anchor channel.
     """
     from .boxes import footprint_corners
+
+    outline, walls, wall_half, openings = shell
+    size, mpp, centre = canvas
 
     image = np.zeros((len(CHANNELS) + n_categories, size, size), np.float32)
     image[0] = fill_polygon(outline, size, mpp, centre)

@@ -81,8 +81,9 @@ def render(room: RoomInput, walls: Walls, view: View, frame: Frame, anchor: int 
     known = cats >= 0
     b = boxes_to_local(frame, room.boxes)
     anchor_k = None if anchor is None else int(np.cumsum(known)[anchor] - 1) if known[anchor] else None
-    image = raster.render_room(to_local(frame, room.outline), segs, walls.thickness / 2, openings, b[known], cats[known],
-                               len(view.categories), view.size, view.mpp, (0.0, 0.0), anchor_k)
+    shell = raster.Shell(to_local(frame, room.outline), segs, walls.thickness / 2, openings)
+    image = raster.render_room(shell, b[known], cats[known], len(view.categories), raster.Canvas(view.size, view.mpp),
+                               anchor_k)
     if anchor_wall is not None:
         raster.fill_quads(image[raster.CHANNELS.index("anchor")], raster.segment_quads(segs[anchor_wall:anchor_wall + 1],
                           walls.thickness[anchor_wall:anchor_wall + 1] / 2), 1.0, view.mpp, (0.0, 0.0))

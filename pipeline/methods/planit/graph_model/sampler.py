@@ -173,7 +173,7 @@ def _edges(st: _State, graphs: torch.Tensor, plans: list[Plan], n_objects: list[
     width = max(len(st.index[b]) for b in graphs.tolist())
     present = torch.nonzero(torch.isin(st.graph, graphs))[:, 0]
     new = torch.tensor([st.index[b][-1] for b in graphs.tolist()])
-    base, stop = candidate_logits(model, st.h, st.x, st.is_arch, st.graph, st.local, present, graphs, new, hg, width)
+    base, stop = candidate_logits(model, st.h, st, present, (graphs, new), hg, width)
     if st.allowed is not None:
         base = base.masked_fill(~_seen_mask(st, graphs, present, new, width), float("-inf"))
     chosen = torch.zeros(len(graphs), width, EDGE_CHOICES)

@@ -152,8 +152,7 @@ def _edge_nll(model, batch, h, hg, kind, e, present) -> torch.Tensor:
     graphs = torch.nonzero(kind == EDGES)[:, 0]
     if not len(graphs):
         return out
-    base, stop = candidate_logits(model, h, batch.x, batch.is_arch, batch.graph, batch.local, present, graphs,
-                                  batch.new[graphs, e], hg, batch.width)
+    base, stop = candidate_logits(model, h, batch, present, (graphs, batch.new[graphs, e]), hg, batch.width)
     rows = torch.nonzero(batch.dec_event == e)[:, 0]
     row_of = torch.full((len(kind),), -1, dtype=torch.long, device=h.device)
     row_of[graphs] = torch.arange(len(graphs), device=h.device)
@@ -170,9 +169,14 @@ def _edge_nll(model, batch, h, hg, kind, e, present) -> torch.Tensor:
     return out.index_put((batch.dec_graph[rows], torch.full_like(rows, 2)), loss, accumulate=True)
 
 
-def candidate_logits(model, h, x, is_arch, graph, local, present, graphs, new, hg, width) -> tuple[torch.Tensor, torch.Tensor]:
-    """Base add-edge logits ``(len(graphs), width, 26)`` of each graph's new node ``new``: every present node of the
-    graph but the new one is a candidate (-inf elsewhere); and the base stop logits ``(len(graphs),)``."""
+def candidate_logits(model, h: torch.Tensor, nodes, present: torch.Tensor, newest: tuple[torch.Tensor, torch.Tensor],
+                     hg: torch.Tensor, width: int) -> tuple[torch.Tensor, torch.Tensor]:
+    """Base add-edge logits ``(len(graphs), width, 26)`` of each graph's new node, ``newest`` = (graphs, their new
+    node): every present node of the graph but the new one is a candidate (-inf elsewhere); and the base stop logits
+    ``(len(graphs),)``. ``nodes``: the batch's node tensors (``x``, ``is_arch``, ``graph``, ``local``: a teacher
+    batch or the sampler's state); ``h``: their states, ``hg``: the graphs' readouts."""
+    graphs, new = newest
+    x, is_arch, graph, local = nodes.x, nodes.is_arch, nodes.graph, nodes.local
     new_of = torch.full((len(hg),), -1, dtype=torch.long, device=h.device)
     new_of[graphs] = new
     cand = present[(new_of[graph[present]] >= 0) & (present != new_of[graph[present]])]
