@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import shapely
@@ -78,7 +79,8 @@ def extract_room(room: RoomInput, mesh_of, symmetry_of, cfg: dict, intersector, 
     group = np.where(tier == 1, 0, parent + 1)
     group[hanging] = n + 1 + np.flatnonzero(hanging)
     group = np.concatenate([group, np.zeros(n_walls, int)])
-    g.rays += _spatial_edges(g, room.room_id, scene, b, all_fp, ids, group, radial, walls, cfg, anchors)
+    g.rays += _spatial_edges(g, room.room_id, PlanLayer(scene, b, all_fp, group, radial, walls, ids + walls.ids), cfg,
+                             anchors)
     if anchors is None:
         _architecture_edges(g, room.room_id, walls, room.openings, cfg["architecture"])
     return g
@@ -151,8 +153,7 @@ def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: fl
         & (scene.up[face] | ~relations.inside_boxes(s_orig[r], b[own])), max_dist=reach)
     footprint = 4 * b[:, 3] * b[:, 4]  # "largest" = widest: a thin counter slab is larger than the kettle on it
     if sc["inside_box_contact"]:
-        _box_contacts(b, footprint, s_orig, s_obj, first_owner, first_dist, reach, sc["start_offset"], boxy,
-                      sc["box_top_tolerance"])
+        _box_contacts(b, footprint, (s_orig, s_obj, first_owner, first_dist), reach, sc, boxy)
     parent, area = relations.choose_parents(s_obj, first_owner, first_dist, cell, reach, footprint)
     if sc["inside_box_contact"] and len(raised):  # raised box, nothing below: held from around (hung in a slab)?
         loose = raised[(parent[raised] < 0) & boxy[raised]]
@@ -164,13 +165,16 @@ def support_parents(scene: RoomScene, b: np.ndarray, sc: dict, floor_contact: fl
     return parent, area, len(s_orig), len(cycles)
 
 
-def _box_contacts(b, footprint, s_orig, s_obj, first_owner, first_dist, reach, start_offset, boxy, top_tolerance) -> None:
+def _box_contacts(b: np.ndarray, footprint: np.ndarray, casts: tuple, reach: float, sc: dict, boxy: np.ndarray) -> None:
     """Box-only sources: a grid point whose ray finds nothing within reach but lies in another object's box rests
-    on the box whose top is level with the object's bottom (within ``top_tolerance``), else on the widest box
-    around it (boxes reach above their support surface: cushions on beds, things in fridges, a desk's hutch; a
+    on the box whose top is level with the object's bottom (within ``sc['box_top_tolerance']``), else on the widest
+    box around it (boxes reach above their support surface: cushions on beds, things in fridges, a desk's hutch; a
     chair tucked under the desk rises above the desk top the bowl stands on). The point just below the object's
-    bottom is tested too (a top level with the bottom hides behind the bottom face); ``footprint (n,)`` m^2. Updates ``first_owner`` /
-    ``first_dist`` in place."""
+    bottom is tested too (a top level with the bottom hides behind the bottom face); ``footprint (n,)`` m^2.
+    ``casts``: the support rays' origins and casters and their first hits' owners and distances, the last two
+    updated in place."""
+    s_orig, s_obj, first_owner, first_dist = casts
+    start_offset, top_tolerance = sc["start_offset"], sc["box_top_tolerance"]
     volume = np.prod(2 * b[:, 3:6], axis=1)
     miss = np.flatnonzero((first_dist > reach) & boxy[s_obj])
     if not len(miss):
@@ -314,19 +318,32 @@ def touching(sides: dict, all_fp: np.ndarray, near: np.ndarray, piece_side: np.n
     return owner
 
 
-def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg, anchors=None) -> int:
+class PlanLayer(NamedTuple):
+    """What the visibility sweep reads of a room: its ray ``scene``, the objects' ``boxes (n, 7)``, the footprints of
+    the objects then the walls ``(n + w, 4, 2)``, each one's sweep ``group (n + w,)`` (who may see whom), which objects
+    are radially symmetric ``(n,)``, the ``walls`` and every node's name (objects, then walls)."""
+    scene: RoomScene
+    boxes: np.ndarray
+    footprints: np.ndarray
+    group: np.ndarray
+    radial: np.ndarray
+    walls: Walls
+    names: list[str]
+
+
+def _spatial_edges(g, room_id: str, layer: PlanLayer, cfg: dict, anchors=None) -> int:
     """Sweep every anchor side (of ``anchors``, ids, when given) and add the visible spatial edges. Returns the
     number of rays cast."""
+    b, all_fp, group, walls, names = layer.boxes, layer.footprints, layer.group, layer.walls, layer.names
     n, n_walls = len(b), len(walls.ids)
     sp = cfg["spatial"]
     sides = anchor_sides(b, walls, sp)
-    names = ids + walls.ids
     if anchors is not None:
         chosen = np.isin(np.asarray(names, object), list(anchors))
         sides = {k: v[chosen[sides["owner"]]] for k, v in sides.items()}
     piece_side, starts, ends, near = sweep(sides, all_fp, group)
     diag = np.concatenate([diagonal_2d(b[:, 3], b[:, 4]), np.zeros(n_walls)])  # walls: the target's diagonal decides
-    p_owner, p_dist, rays = _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n)
+    p_owner, p_dist, rays = _cast_pieces(layer, sides, (piece_side, starts, ends), diag)
     touch = touching(sides, all_fp, near, piece_side, starts, ends)
     p_owner = np.where(touch >= 0, touch, p_owner)
     ok = (p_owner >= 0) & (p_owner < n)  # pieces that reach an object (walls only occlude)
@@ -353,12 +370,15 @@ def _spatial_edges(g, room_id, scene, b, all_fp, ids, group, radial, walls, cfg,
     u_anchor, u_sidx = sides["owner"][u_side], sides["side"][u_side]
     seen = {"anchor": u_anchor, "target": u_target, "side": u_sidx, "gap": gap, "target_share": target_share,
             "anchor_share": anchor_share, "score": np.maximum(target_share, anchor_share)}
-    _emit_spatial_edges(g, room_id, seen, contained, names, n, diag, radial, cfg)
+    _emit_spatial_edges(g, room_id, seen, contained, layer, diag, cfg)
     return rays
 
 
-def _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n) -> tuple[np.ndarray, np.ndarray, int]:
-    """Two rays per sweep piece in the plan layer; per piece the nearer hit's owner and distance."""
+def _cast_pieces(layer: PlanLayer, sides: dict, pieces: tuple, diag: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Two rays per sweep piece ``pieces`` (side, start, end) in the plan layer; per piece the nearer hit's owner and
+    distance."""
+    scene, group, n = layer.scene, layer.group, len(layer.boxes)
+    piece_side, starts, ends = pieces
     pos, ray_piece = relations.piece_rays(starts, ends, PIECE_INSET)
     ray_side = piece_side[ray_piece]
     xy = sides["centre"][ray_side] + pos[:, None] * sides["tangent"][ray_side] - sides["normal"][ray_side] * sides["inset"][ray_side, None]
@@ -377,8 +397,9 @@ def _cast_pieces(scene, sides, piece_side, starts, ends, group, diag, n) -> tupl
     return hit_owner.reshape(-1, 2)[np.arange(len(pr)), pick], pr[np.arange(len(pr)), pick], len(origins)
 
 
-def _emit_spatial_edges(g, room_id, seen: dict, contained, names, n, diag, radial, cfg) -> None:
+def _emit_spatial_edges(g, room_id: str, seen: dict, contained, layer: PlanLayer, diag: np.ndarray, cfg: dict) -> None:
     """One edge per (anchor, target) from the best qualifying side: highest visibility, then smallest gap."""
+    names, n, radial = layer.names, len(layer.boxes), layer.radial
     total = len(names)
     a_, t_ = seen["anchor"], seen["target"]
     side_scores = np.zeros((total, total, 4))
