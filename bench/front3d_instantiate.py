@@ -43,7 +43,7 @@ def main() -> None:
     meshes, box_models = tables.read_meshes(outs["models"], t["objects"]["model_id"].dropna())
     sym = {r["model_id"]: r["symmetry"] for r in tables.read(w / "sym.parquet", "symmetry").to_pylist()}
     plans = own_plans(pd.read_parquet(w / "nodes.parquet"), pd.read_parquet(w / "edges.parquet"))
-    rows = reinstantiate(t["rooms"], t["architecture"], t["objects"], meshes, box_models, sym, cfg, plans)
+    rows = reinstantiate(t, (meshes, box_models, sym), cfg, plans)
     for r in rows:
         print(r["room_id"], r["objects"], "placed" if r["placed"] else r["reason"], f"{r['consistency']:.3f}", f"{r['seconds']:.1f} s")
     ic = cfg["instantiate"]

@@ -403,7 +403,7 @@ def test_real_3d_front_rooms_are_placed_again_from_their_own_graphs(tmp_path):
     assert len(plans) >= 3
     meshes, box_models = tables.read_meshes(outs["models"], t["objects"].model_id.dropna())
     sym = {r["model_id"]: r["symmetry"] for r in tables.read(tmp_path / "sym.parquet", "symmetry").to_pylist()}
-    rows = reinstantiate(t["rooms"], t["architecture"], t["objects"], meshes, box_models, sym, cfg, plans)
+    rows = reinstantiate(t, (meshes, box_models, sym), cfg, plans)
     assert len(rows) == len(plans)
     assert all(r["placed"] or r["reason"] for r in rows)
     placed = [r for r in rows if r["placed"]]

@@ -23,9 +23,13 @@ def own_plans(nodes: pd.DataFrame, edges: pd.DataFrame, distances=("adjacent",))
     return plans_from_tables(nodes, edges[keep].assign(status="kept"))
 
 
-def reinstantiate(rooms: pd.DataFrame, architecture: pd.DataFrame, objects: pd.DataFrame, meshes: dict, box_models: set,
-                  symmetry: dict, config: dict, plans, min_objects: int = 3, seed: int = 0) -> list[dict]:
-    """One row per room with at least ``min_objects`` planned objects: placed or not, why, consistency, collisions."""
+def reinstantiate(frames: dict[str, pd.DataFrame], models: tuple[dict, set, dict], config: dict, plans,
+                  min_objects: int = 3, seed: int = 0) -> list[dict]:
+    """One row per room with at least ``min_objects`` planned objects: placed or not, why, consistency, collisions.
+    ``frames``: the rooms', architecture and objects tables (``rooms``, ``architecture``, ``objects``); ``models``:
+    the meshes by model id, the box-only model ids and the symmetry type by model id."""
+    rooms, architecture, objects = frames["rooms"], frames["architecture"], frames["objects"]
+    meshes, box_models, symmetry = models
     ext = {"floor_contact": config["floor_contact"], **config["extract"]}
     ic = config["instantiate"]
     checker = Checker(meshes, box_models, symmetry, ext, intersector_class(ext["backend"]), checks_config(config))
