@@ -27,16 +27,18 @@ EXTRA = ["consistency", "violation", "nn_similarity", "contents_excess", "conten
 
 
 def evaluate_room_type(config: dict[str, Any], room_type: str, gen: list[RoomSet], train: RoomSet, real: RoomSet,
-                       meshes: dict[str, Any], box_models: set[str], symmetry: dict[str, str],
+                       models: tuple[dict[str, Any], set[str], dict[str, str]],
                        threads: int = 1) -> tuple[dict[str, Any], pd.DataFrame]:
     """``metrics.json``'s content and the ``eval_scenes`` rows of every set (``gen``: the methods' sets, the first
-    one the reference of the differences and the goals)."""
+    one the reference of the differences and the goals); ``models``: meshes by model id, the box-only model ids and
+    the symmetry type by model id."""
+    meshes, box_models, symmetry = models
     ev = config["evaluate"]
     index = {c: k for k, c in enumerate(sorted({c for s in (train, real, *gen) for r in s.rooms for c in r.categories}))}
     train_maps = label_maps(train, index, ev["render"])
     learned = functional.learn_checks(train.rooms, ev["functional"], symmetry)
     by_name = {rs.name: rs for rs in (*gen, real)}
-    rows = {name: room_rows(rs, learned, index, (meshes, box_models, symmetry), train_maps,
+    rows = {name: room_rows(rs, learned, index, models, train_maps,
                             [r.room_id for r in train.rooms], config) for name, rs in by_name.items()}
     checks = [functional.check_name(c) for c in learned["checks"]]
     stat = lambda frame, ref: intervals.figures(frame, ref, ev["kl_eps"], EXTRA + checks)

@@ -20,10 +20,11 @@ def _rule_view(g: Graph, vocab: Vocab) -> tuple[list[str], list[tuple[int, int, 
     return cats, [(int(s), int(t), EDGE_CLASSES[int(c)]) for s, t, c in g.edges]
 
 
-def graph_model_metrics(config: dict[str, Any], room_type: str, vocab: Vocab, real: list[Graph], train: list[Graph],
-                        held: list[Graph], gen: list[Graph], heldout_nll: dict[str, Any] | None,
-                        valid_before_rejection: float) -> dict[str, Any]:
-    """The metrics and goals of one room type's generated graphs ``gen`` against its ``held`` real graphs."""
+def graph_model_metrics(config: dict[str, Any], room_type: str, vocab: Vocab, sets: dict[str, list[Graph]],
+                        heldout_nll: dict[str, Any] | None, valid_before_rejection: float) -> dict[str, Any]:
+    """The metrics and goals of one room type's generated graphs against its held-out real graphs; ``sets``: the
+    ``real`` graphs (all), the ``train`` and ``heldout`` ones and the ``generated`` ones."""
+    real, train, held, gen = sets["real"], sets["train"], sets["heldout"], sets["generated"]
     rng = rng_for(config["seed"], "graph-floor")
     floor_set = [train[i] for i in rng.permutation(len(train))[:min(len(gen) or len(train), len(train))]]
     floor = gm.distances(held, floor_set)

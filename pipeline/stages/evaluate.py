@@ -22,8 +22,8 @@ def run(config: dict, inp: Files, out: Files, room_type: str, threads: int = 1) 
     meshes, box_models = tables.read_meshes_of(inp.models, {m for rs in (train, real, *gen) for r in rs.rooms
                                                             for m in r.model_ids})
     sym = tables.read(inp.symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
-    metrics, frame = evaluate_room_type(config, room_type, gen, train, real, meshes, box_models,
-                                        {r["model_id"]: r["symmetry"] for r in sym}, threads)
+    metrics, frame = evaluate_room_type(config, room_type, gen, train, real,
+                                        (meshes, box_models, {r["model_id"]: r["symmetry"] for r in sym}), threads)
     tables.write(out.scenes, "eval_scenes", tables.from_rows("eval_scenes", tables.records(frame)))
     tables.write_csv(out.table, metrics_table(metrics))
     write_html(out.table_html, evaluation_page(metrics))

@@ -28,7 +28,8 @@ def run(config: dict, inp: Files, out: Files, room_type: str, generator: str = "
     gen = graph_data.graphs_from_tables(tables.read(inp.gen_nodes, "generated_nodes").to_pandas(),
                                         tables.read(inp.gen_edges, "generated_edges").to_pandas(), vocab)
     valid = json.loads(Path(inp.sample_summary).read_text())["valid_before_rejection"]
-    metrics = graph_model_metrics(config, room_type, vocab, real, train, held, gen, saved["heldout_nll"], valid)
+    sets = {"real": real, "train": train, "heldout": held, "generated": gen}
+    metrics = graph_model_metrics(config, room_type, vocab, sets, saved["heldout_nll"], valid)
     tables.write_json(out.metrics, metrics)
     log.info("%s: %s", room_type, metrics["goals"])
     return metrics
