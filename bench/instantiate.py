@@ -52,8 +52,7 @@ from common import ROOT, arguments, corpus_paths, report, search_flags, search_o
 def corpus_of(cfg: dict, room_type: str):
     """The kept rooms of a room type as every method reads them (the default run's outputs)."""
     p = corpus_paths(cfg)
-    return load_corpus(room_type, p["rooms"], p["architecture"], p["objects"], p["models"],
-                       p["splits"] / f"{room_type}.parquet", p["symmetry"], p["category_sizes"])
+    return load_corpus(room_type, {**p, "split": p["splits"] / f"{room_type}.parquet"})
 
 
 def probe_networks(cfg, room_type: str, saved, probes: int, checker) -> dict:

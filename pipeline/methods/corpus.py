@@ -3,6 +3,7 @@ method's generated rooms (:class:`~pipeline.methods.interface.Generated`)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Mapping
 
 from .. import tables
 from ..graphs.files import read_split
@@ -10,8 +11,12 @@ from ..room import load_rooms
 from .interface import Corpus, Generated
 
 
-def load_corpus(room_type: str, rooms: list[Path], architecture: list[Path], objects: list[Path], models: list[Path],
-                split: Path, symmetry: Path, category_sizes: Path) -> Corpus:
+def load_corpus(room_type: str, files: Mapping[str, Any]) -> Corpus:
+    """One room type's :class:`~pipeline.methods.interface.Corpus` from its ``files`` (a stage's inputs): the
+    ``rooms``, ``architecture``, ``objects`` and ``models`` shards, its ``split`` table, the ``symmetry`` and
+    ``category_sizes`` tables (None: absent)."""
+    rooms, architecture, objects, models = files["rooms"], files["architecture"], files["objects"], files["models"]
+    split, symmetry, category_sizes = files["split"], files["symmetry"], files["category_sizes"]
     room_df, arch, objs, inputs = load_rooms(rooms, architecture, objects)
     room_df = room_df[room_df["room_type"].astype(str) == room_type]
     ids = set(room_df["room_id"])

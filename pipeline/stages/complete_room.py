@@ -11,7 +11,6 @@ from ..stage import Files
 def run(config: dict, inp: Files, out: Files, room_type: str, room: str, keep: int, threads: int = 1) -> dict:
     from ..methods.planit.layout import CompleteRoom
 
-    corpus = load_corpus(room_type, inp.rooms, inp.architecture, inp.objects, inp.models, inp.split, inp.symmetry,
-                         inp.category_sizes)
+    corpus = load_corpus(room_type, inp)
     task = Task(config, "complete", corpus, (inp.nodes, inp.edges), inp.model, threads=threads)
     return generate_rooms(CompleteRoom(config, room, keep), "complete", task, out)

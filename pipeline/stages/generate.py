@@ -13,8 +13,7 @@ def run(config: dict, inp: Files, out: Files, room_type: str, method: str, count
         threads: int = 1) -> dict:
     methods.load_plugins(config["generation"]["plugins"])
     spec = methods.get(method)
-    corpus = load_corpus(room_type, inp.rooms, inp.architecture, inp.objects, inp.models, inp.split, inp.symmetry,
-                         inp.category_sizes)
+    corpus = load_corpus(room_type, inp)
     reference = inp.reference_rooms and load_generated(inp.reference_rooms, inp.reference_architecture,
                                                        inp.reference_objects, inp.reference_scenes)
     graphs = (inp.nodes, inp.edges) if inp.nodes else None

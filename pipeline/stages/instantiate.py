@@ -12,7 +12,6 @@ def run(config: dict, inp: Files, out: Files, room_type: str, variant: str, coun
         threads: int = 1) -> dict:
     from ..methods.planit.layout import PlanitLayout
 
-    corpus = load_corpus(room_type, inp.rooms, inp.architecture, inp.objects, inp.models, inp.split, inp.symmetry,
-                         inp.category_sizes)
+    corpus = load_corpus(room_type, inp)
     task = Task(config, variant, corpus, (inp.nodes, inp.edges), inp.model, count=count, threads=threads)
     return generate_rooms(PlanitLayout(config, variant), variant, task, out)

@@ -12,7 +12,6 @@ def run(config: dict, inp: Files, out: Files, threads: int = 1) -> dict:
     from ..methods.planit.layout import PlanitLayout
 
     types = tables.read(inp.nodes, "generated_nodes", columns=["room_type"]).column("room_type").unique().to_pylist()
-    corpus = load_corpus(str(types[0]) if types else "", inp.rooms, inp.architecture, inp.objects, inp.models,
-                         inp.split, inp.symmetry, inp.category_sizes)
+    corpus = load_corpus(str(types[0]) if types else "", inp)
     task = Task(config, "planit", corpus, (inp.nodes, inp.edges), inp.model, threads=threads)
     return generate_rooms(PlanitLayout(config, "planit"), "planit", task, out)
