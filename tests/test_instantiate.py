@@ -19,7 +19,7 @@ from pipeline.placement.layout import View, add_object, render, walls_of, with_o
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
 from pipeline.placement.retrieval import ModelPool, place
-from pipeline.placement.search import instantiate
+from pipeline.placement.search import Kit, instantiate
 from pipeline.stage import Files
 
 from conftest import Room, default_config
@@ -69,7 +69,7 @@ def test_hand_built_bedroom_is_placed_and_its_extracted_graph_holds_every_planne
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
     assert [plan.ids[k] for k in seq][:3] == ["bed", "ns_l", "ns_r"]  # the hub, then its spokes; supported last
-    out = instantiate(plan, room, walls, seq, Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, seed)
+    out = instantiate(plan, room, seq, Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, seed)
     assert out.ok, out.reason
     assert sorted(out.room.object_ids) == sorted(plan.ids)
     m = scene_metrics.consistency(plan, out.room, walls.ids, checker)  # a fresh extraction of the finished room
@@ -83,7 +83,7 @@ def test_same_seed_same_room():
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
-    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 5) for _ in range(2))
+    a, b = (instantiate(plan, room, seq, Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 5) for _ in range(2))
     assert np.array_equal(a.room.boxes, b.room.boxes)
 
 
@@ -107,7 +107,7 @@ def test_backtracking_recovers_from_a_planted_impossible_first_choice():
                                         PlanEdge("wall_0", "d", "spatial", "front", "adjacent"),
                                         PlanEdge("w", "d", "spatial", "right", "adjacent")])
     proposer = Combined(PlantedCorner(), FaceAway())
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), proposer, pool, checker,
+    out = instantiate(plan, room, order.placement_order(plan, AREAS), proposer, Kit(pool, checker),
                       {**ic, "lookahead": "none"}, 0)
     assert not proposer.location.first  # the planted corner was proposed
     assert out.ok and out.backtracks >= 1, (out.reason, out.backtracks)
@@ -117,7 +117,7 @@ def test_backtracking_recovers_from_a_planted_impossible_first_choice():
     # with forward checking the corner is refused where it is proposed (it leaves the desk no cell beside the
     # wardrobe against the wall): no backtrack at all
     proposer = Combined(PlantedCorner(), FaceAway())
-    looked = instantiate(plan, room, walls, order.placement_order(plan, AREAS), proposer, pool, checker,
+    looked = instantiate(plan, room, order.placement_order(plan, AREAS), proposer, Kit(pool, checker),
                          {**ic, "lookahead": "at_zero_tolerance"}, 0)
     assert not proposer.location.first and looked.ok and looked.backtracks == 0, (looked.reason, looked.failures)
     assert looked.failures.get("forecloses", 0) >= 1
@@ -135,12 +135,12 @@ def _unsatisfiable():
 
 def test_an_unsatisfiable_graph_ends_with_a_failure_record_not_a_hang():
     room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=6, restarts=2)
-    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(_unsatisfiable(), room, [0], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 0)
     assert not out.ok and "backtrack budget (6) spent: no place for b (bed)" in out.reason
     assert out.attempts == 3 and out.backtracks == 3 * 6  # every restart spent its own budget; the counts add up
     assert out.rejections > 0 and out.room.object_ids == []
     assert set(out.failures) == {"outside"}
-    once = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker,
+    once = instantiate(_unsatisfiable(), room, [0], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker),
                        {**ic, "restarts": 0}, 0)
     assert once.attempts == 1 and once.backtracks == 6 and 0 < once.rejections < out.rejections
 
@@ -152,9 +152,9 @@ def test_the_backtrack_budget_grows_with_the_objects_to_place():
     two = ScenePlan("s3", "r0", "bedroom", ["b", "c"], ["bed", "bed"], ["left-right"] * 2, [1, 1], [None, None],
                     ["none", "none"], [PlanEdge("wall_0", "b", "spatial", "front", "adjacent")])
     prior = Combined(RelationPrior(EXTRACT), FaceAway())
-    out = instantiate(two, room, walls, [0, 1], prior, pool, checker, ic, 0)
+    out = instantiate(two, room, [0, 1], prior, Kit(pool, checker), ic, 0)
     assert not out.ok and out.backtracks == 10 and "backtrack budget (10) spent" in out.reason
-    one = instantiate(_unsatisfiable(), room, walls, [0], prior, pool, checker, ic, 0)
+    one = instantiate(_unsatisfiable(), room, [0], prior, Kit(pool, checker), ic, 0)
     assert one.backtracks == 6 and "backtrack budget (6) spent" in one.reason
 
 
@@ -167,10 +167,10 @@ def test_a_scene_whose_first_search_spends_its_budget_is_placed_by_a_restart():
                                         PlanEdge("wall_0", "d", "spatial", "front", "adjacent"),
                                         PlanEdge("w", "d", "spatial", "right", "adjacent")])
     seq = order.placement_order(plan, AREAS)
-    failed = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), pool, checker,
+    failed = instantiate(plan, room, seq, Combined(PlantedCorner(), FaceAway()), Kit(pool, checker),
                          {**ic, "restarts": 0}, 0)
     assert not failed.ok and failed.attempts == 1 and "backtrack budget (0) spent: no place for d" in failed.reason
-    out = instantiate(plan, room, walls, seq, Combined(PlantedCorner(), FaceAway()), pool, checker, {**ic, "restarts": 2}, 0)
+    out = instantiate(plan, room, seq, Combined(PlantedCorner(), FaceAway()), Kit(pool, checker), {**ic, "restarts": 2}, 0)
     assert out.ok and out.attempts == 2, out.reason
     assert out.rejections >= failed.rejections  # the failed attempt's rejections are counted too
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
@@ -180,7 +180,7 @@ def test_restarts_leave_a_scene_placed_at_the_first_attempt_unchanged():
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
     seq = order.placement_order(plan, AREAS)
-    a, b = (instantiate(plan, room, walls, seq, Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker,
+    a, b = (instantiate(plan, room, seq, Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker),
                         {**ic, "restarts": n}, 1) for n in (0, 3))
     assert a.ok and b.ok and a.attempts == b.attempts == 1
     assert np.array_equal(a.room.boxes, b.room.boxes) and a.rejections == b.rejections
@@ -196,7 +196,7 @@ def test_an_object_with_no_place_fails_the_scene_or_is_dropped_with_what_it_supp
                      ["left-right", "left-right", "radial"], [1, 1, 2], [None, None, "b"], ["none"] * 3,
                      [PlanEdge("wall_0", "b", "spatial", "front", "adjacent"),
                       PlanEdge("wall_0", "n", "spatial", "front", "adjacent"), PlanEdge("b", "l", "support", None, None)])
-    out = instantiate(plan, room, walls, [0, 1, 2], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(plan, room, [0, 1, 2], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 0)
     if mode == "fail":
         assert out.status == "failed" and "no place for b (bed)" in out.reason and out.room.object_ids == []
     else:
@@ -218,7 +218,7 @@ def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_c
     room, walls, pool, checker, ic = setup(["nightstand"], NARROW, on_exhausted=mode)
     plan = ScenePlan("s4", "r0", "bedroom", ["n", "v"], ["nightstand", "vacuum_cleaner"], ["left-right", "none"],
                      [1, 1], [None, None], ["none"] * 2, [PlanEdge("wall_0", "n", "spatial", "front", "adjacent")])
-    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(plan, room, [0, 1], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 0)
     if mode == "fail":
         assert out.status == "failed" and out.reason == "no training instance of category 'vacuum_cleaner' for v"
         assert out.room.object_ids == []  # failed before placing the nightstand
@@ -230,7 +230,7 @@ def test_a_category_no_training_room_holds_fails_the_scene_or_is_dropped_not_a_c
 
 def test_the_time_budget_ends_a_scene_with_its_reason():
     room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, time_budget=0.3)
-    out = instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
+    out = instantiate(_unsatisfiable(), room, [0], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 0)
     assert not out.ok and out.reason.startswith("time budget (0.3 s) spent")
 
 
@@ -238,7 +238,7 @@ def test_the_candidate_budget_ends_a_scene_the_same_way_on_any_machine():
     """Work, not seconds: the search stops after exactly ``candidate_budget`` candidates, with its reason, whatever
     the load (the time budget, far above, is not reached)."""
     room, walls, pool, checker, ic = setup(["bed"], NARROW, max_backtracks=10_000, candidate_budget=40, restarts=2)
-    runs = [instantiate(_unsatisfiable(), room, walls, [0], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 0)
+    runs = [instantiate(_unsatisfiable(), room, [0], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 0)
             for _ in range(2)]
     for out in runs:
         assert not out.ok and out.reason == "candidate budget (40) spent at object 1 of 1"
@@ -252,7 +252,7 @@ def test_an_l_shaped_room_keeps_furniture_inside_its_outline():
     plan = ScenePlan("s3", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1], [None, None],
                      ["none", "none"], [PlanEdge(walls.ids[2], "w", "spatial", "front", "adjacent"),
                                         PlanEdge(walls.ids[3], "d", "spatial", "front", "adjacent")])
-    out = instantiate(plan, room, walls, [0, 1], Combined(RelationPrior(EXTRACT), FaceAway()), pool, checker, ic, 3)
+    out = instantiate(plan, room, [0, 1], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 3)
     assert out.ok, out.reason
     corners = footprint_corners(*out.room.boxes[:, [0, 1, 3, 4, 6]].T)
     assert (outside_area(np.array(outline, float), corners, ic["checks"]["outside"]) <= 1e-4).all()
@@ -286,8 +286,8 @@ def test_frames_round_trip_and_rename_sides():
 def test_the_glb_reloads_with_one_node_per_object_wall_and_the_floor(tmp_path):
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
-                      pool, checker, ic, 0)
+    out = instantiate(plan, room, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
+                      Kit(pool, checker), ic, 0)
     scene = export.room_scene(out.room, walls, checker.meshes.get)
     raw = export.glb(out.room, walls, checker.meshes.get)  # the bytes scenes.zip holds
     back = trimesh.load(io.BytesIO(raw), file_type="glb")
@@ -457,8 +457,8 @@ def test_a_density_is_found_again_for_a_rebuilt_room_with_the_same_content_and_o
 
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"])
     plan = bedroom_plan()
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
-                      pool, checker, ic, 0)
+    out = instantiate(plan, room, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
+                      Kit(pool, checker), ic, 0)
     bed_only = with_objects(out.room, [out.room.object_ids.index("bed")])
     preset = default_config()["placement"]["presets"]["tiny"]
     cats = ("bed", "nightstand", "table_lamp")
@@ -491,7 +491,7 @@ def _desk_right_of_a_wardrobe_flush_with_the_wall(early: bool):
     room = add_object(room, "w", "wardrobe", inst.model_id, box, pose)
     plan = ScenePlan("s3", "r0", "office", ["w", "d"], ["wardrobe", "desk"], ["left-right", "none"], [1, 1],
                      [None, None], ["none", "none"], [PlanEdge("w", "d", "spatial", "right", "adjacent")])
-    return instantiate(plan, room, walls, [1], Combined(RelationPrior(EXTRACT, soft=1e-3), FaceAway()), pool, checker, ic, 0)
+    return instantiate(plan, room, [1], Combined(RelationPrior(EXTRACT, soft=1e-3), FaceAway()), Kit(pool, checker), ic, 0)
 
 
 def test_early_backtrack_skips_the_samples_of_an_object_no_band_leaves_a_cell_for():
@@ -504,8 +504,8 @@ def test_early_backtrack_skips_the_samples_of_an_object_no_band_leaves_a_cell_fo
 def test_early_backtrack_still_places_the_hand_built_bedroom_with_every_planned_edge():
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"], early_backtrack=True)
     plan = bedroom_plan()
-    out = instantiate(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
-                      pool, checker, ic, 0)
+    out = instantiate(plan, room, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()),
+                      Kit(pool, checker), ic, 0)
     assert out.ok, out.reason
     assert scene_metrics.consistency(plan, out.room, walls.ids, checker)["consistency"] == 1.0
 
@@ -519,8 +519,8 @@ def test_the_free_floor_kept_between_samples_follows_every_insertion_and_backtra
     l_room = ((0, 0), (4, 0), (4, 2), (2, 2), (2, 4), (0, 4))
     room, walls, pool, checker, ic = setup(["bed", "nightstand", "table_lamp"], outline=l_room)
     plan = bedroom_plan()
-    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()), pool,
-               checker, ic, np.random.default_rng(0))
+    s = Search(plan, room, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool,
+               checker), ic, np.random.default_rng(0))
     half = np.array([0.25, 0.2])
     empty = s.free_floor(half)
     empty[:] = False  # the caller's copy
@@ -545,8 +545,8 @@ def test_a_supported_object_is_offered_the_part_of_its_support_no_sibling_covers
 
     room, walls, pool, checker, ic = setup(["desk", "table_lamp"], free_support=free)
     plan = bedroom_plan()
-    s = Search(plan, room, walls, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()), pool,
-               checker, ic, np.random.default_rng(0))
+    s = Search(plan, room, order.placement_order(plan, AREAS), Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool,
+               checker), ic, np.random.default_rng(0))
     s.room = add_object(room, "desk", "desk", "m", np.array([2.0, 1.5, 0.375, 0.6, 0.3, 0.375, 0.0]),
                         np.array([2.0, 1.5, 0.0, 0.0, 1.0, 1.0, 1.0]))
     s.room = add_object(s.room, "lamp", "table_lamp", "m", np.array([1.6, 1.5, 0.95, 0.1, 0.1, 0.2, 0.0]),

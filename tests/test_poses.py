@@ -21,7 +21,7 @@ from pipeline.placement.layout import add_object, box_frame, wall_frame, walls_o
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import BackToWall, Centred, Combined, FaceAnchor, FaceAway, FacingPartner, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
-from pipeline.placement.search import instantiate
+from pipeline.placement.search import Kit, instantiate
 from pipeline.placement.support import CentreLine, Window, back_gap, learn_centring
 from pipeline.placement.walls import learn_wall_backs
 
@@ -189,7 +189,7 @@ def test_a_bed_planned_against_a_wall_gets_its_back_to_that_wall(learned, kind):
     for w in (1, 2):  # the right wall, the top wall
         plan = plan_of("b", "bed", [PlanEdge(walls.ids[w], "b", "spatial", "front", "adjacent")])
         for seed in SEEDS:
-            bed = placed(instantiate(plan, room, walls, [0], proposer, pool, checker, cfg["instantiate"], seed), "b")
+            bed = placed(instantiate(plan, room, [0], proposer, Kit(pool, checker), cfg["instantiate"], seed), "b")
             assert turn_error(bed[6] - wall_frame(walls, w).yaw) <= math.radians(5), (kind, w, seed, bed)
             assert back_to_wall(bed[None], room.outline, 0.1, math.radians(15))[0]
 
@@ -205,7 +205,7 @@ def test_a_nightstand_planned_beside_a_bed_stands_at_its_head(learned, kind):
     for side in ("left", "right"):
         plan = plan_of("n", "nightstand", [PlanEdge("bed", "n", "spatial", side, "adjacent")])
         for seed in SEEDS:
-            out = instantiate(plan, room, walls, [0], proposer, pool, checker, cfg["instantiate"], seed)
+            out = instantiate(plan, room, [0], proposer, Kit(pool, checker), cfg["instantiate"], seed)
             b = out.room.boxes
             heads += REGIONS[regions(b)[0, 1]] == "side_back"
             assert turn_error(placed(out, "n")[6] - b[0, 6], "left-right") <= math.radians(5)  # turned with the bed
@@ -221,7 +221,7 @@ def test_a_tv_planned_on_a_stand_faces_the_way_the_stand_faces(learned, kind):
         base = given(room, pool, "tv_stand", "stand", xy, yaw)
         plan = plan_of("t", "tv", [PlanEdge("stand", "t", "support", None, None)], parent="stand")
         for seed in SEEDS:
-            tv = placed(instantiate(plan, base, walls, [0], proposer_of(kind, saved, cfg), pool, checker,
+            tv = placed(instantiate(plan, base, [0], proposer_of(kind, saved, cfg), Kit(pool, checker),
                                     cfg["instantiate"], seed), "t")
             assert turn_error(tv[6] - math.radians(yaw)) <= math.radians(5), (kind, yaw, seed, tv)
 
@@ -247,7 +247,7 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
     plan = plan_of("t", "tv", [PlanEdge("stand", "t", "support", None, None)], parent="stand")
     uniform = Combined(UniformLocation(), FaceAway())
     offset = lambda proposer, seed: np.abs(to_local(box_frame(base.boxes[0]), placed(
-        instantiate(plan, base, walls, [0], proposer, pool, checker, cfg["instantiate"], seed), "t")[:2]))
+        instantiate(plan, base, [0], proposer, Kit(pool, checker), cfg["instantiate"], seed), "t")[:2]))
     assert max(offset(uniform, seed).max() for seed in SEEDS) > 0.05
     centred = Centred(uniform, {("tv_stand", "tv", "support"): (1.0, 1.0)})
     assert max(offset(centred, seed).max() for seed in SEEDS) < 1e-9
@@ -259,7 +259,7 @@ def test_objects_stand_on_their_anchors_centre_lines_as_often_as_in_the_training
     plan = plan_of("c", "chair", [PlanEdge("desk", "c", "spatial", "front", "adjacent")])
     chair = Centred(Combined(RelationPrior(cfg["extract"]), FaceAway()), {("desk", "chair", "spatial"): (1.0, 0.0)})
     for seed in SEEDS:
-        c = placed(instantiate(plan, desk, walls, [0], chair, pool, checker, cfg["instantiate"], seed), "c")
+        c = placed(instantiate(plan, desk, [0], chair, Kit(pool, checker), cfg["instantiate"], seed), "c")
         assert abs(to_local(box_frame(desk.boxes[0]), c[:2])[0]) < 1e-9, seed
 
 
@@ -305,7 +305,7 @@ def test_objects_stand_as_far_off_their_anchors_centre_lines_as_in_the_training_
     chair = Centred(Combined(RelationPrior(cfg["extract"]), FaceAway()),
                     {("desk", "chair", "spatial"): CentreLine(1.0, 0.0, (-0.05, 0.04))})
     across = [round(float(to_local(box_frame(desk.boxes[0]), placed(instantiate(
-        plan, desk, walls, [0], chair, pool, checker, cfg["instantiate"], seed), "c")[:2])[0]), 6) for seed in SEEDS]
+        plan, desk, [0], chair, Kit(pool, checker), cfg["instantiate"], seed), "c")[:2])[0]), 6) for seed in SEEDS]
     assert set(across) == {-0.05, 0.04}, across
 
 
@@ -343,7 +343,7 @@ def test_objects_planned_against_a_wall_turn_their_back_to_it_as_often_as_in_the
     room, walls, pool, checker, cfg = setup_room(furnished(0))
     plan = plan_of("d", "desk", [PlanEdge(walls.ids[1], "d", "spatial", "front", "adjacent")])
     drawn = Combined(RelationPrior(cfg["extract"]), Sideways())
-    desk = lambda proposer, seed: placed(instantiate(plan, room, walls, [0], proposer, pool, checker,
+    desk = lambda proposer, seed: placed(instantiate(plan, room, [0], proposer, Kit(pool, checker),
                                                      cfg["instantiate"], seed), "d")
     assert all(turn_error(desk(drawn, seed)[6] - wall_frame(walls, 1).yaw) > 1.5 for seed in SEEDS)
     backed = BackToWall(drawn, {"desk": 1.0})
@@ -401,7 +401,7 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
     base = given(room, pool, "tv_stand", "stand", (0.2, 2.0), 270)
     plan = plan_of("t", "tv", [PlanEdge("stand", "t", "support", None, None)], parent="stand")
     uniform = Combined(UniformLocation(), FaceAway())
-    tv = lambda proposer, seed: placed(instantiate(plan, base, walls, [0], proposer, pool, checker, cfg["instantiate"],
+    tv = lambda proposer, seed: placed(instantiate(plan, base, [0], proposer, Kit(pool, checker), cfg["instantiate"],
                                                    seed), "t")
     assert max(abs(back_gap(base.boxes[0], tv(uniform, seed)) - 0.01) for seed in SEEDS) > 0.02
     at_back = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01)})
@@ -433,13 +433,13 @@ def test_two_objects_facing_each_other_stand_on_one_axis_as_in_the_training_room
     plan = plan_of("c", "chair", [PlanEdge(walls.ids[2], "c", "spatial", "front", "adjacent")])
     drawn = Combined(RelationPrior(cfg["extract"]), FaceAway())
     across = lambda proposer, seed: to_local(box_frame(desk.boxes[0]), placed(
-        instantiate(plan, desk, walls, [0], proposer, pool, checker, cfg["instantiate"], seed), "c")[:2])[0]
+        instantiate(plan, desk, [0], proposer, Kit(pool, checker), cfg["instantiate"], seed), "c")[:2])[0]
     assert max(abs(across(drawn, seed)) for seed in SEEDS) > 0.3
     centred = Centred(drawn, {("desk", "chair", "facing"): (1.0, 0.0)})
     assert max(abs(across(centred, seed)) for seed in SEEDS) < 1e-9
     # not when it would stand beside the desk rather than across from it: a chair planned against the right wall
     side = plan_of("c", "chair", [PlanEdge(walls.ids[1], "c", "spatial", "front", "adjacent")])
-    beside = [to_local(box_frame(desk.boxes[0]), placed(instantiate(side, desk, walls, [0], centred, pool, checker,
+    beside = [to_local(box_frame(desk.boxes[0]), placed(instantiate(side, desk, [0], centred, Kit(pool, checker),
                                                                     cfg["instantiate"], seed), "c")[:2])[0]
               for seed in SEEDS]
     assert min(abs(u) for u in beside) > 1.0
@@ -469,7 +469,7 @@ def test_objects_planned_beside_an_anchor_face_it_as_often_as_in_the_training_ro
     room, walls, pool, checker, cfg = setup_room(furnished(0))
     desk = given(room, pool, "desk", "desk", (2.2, 0.3), 0)
     plan = plan_of("c", "chair", [PlanEdge("desk", "c", "spatial", "front", "proximal")])
-    chair = lambda proposer, seed: placed(instantiate(plan, desk, walls, [0], proposer, pool, checker,
+    chair = lambda proposer, seed: placed(instantiate(plan, desk, [0], proposer, Kit(pool, checker),
                                                       cfg["instantiate"], seed), "c")
     angle = lambda proposer, seed: facing_angles(np.vstack([desk.boxes.reshape(-1, 7), chair(proposer, seed)]))[0, 1]
     drawn = Combined(RelationPrior(cfg["extract"]), Sideways())
@@ -504,12 +504,12 @@ def test_objects_face_the_placed_objects_the_training_rooms_objects_face_where_t
     plan = plan_of("c", "chair", [PlanEdge(walls.ids[2], "c", "spatial", "front", "adjacent")])
     drawn = Combined(RelationPrior(cfg["extract"]), FaceAway())
     faces = lambda proposer, seed: bool(facing_each_other(np.vstack([desk.boxes.reshape(-1, 7), placed(
-        instantiate(plan, desk, walls, [0], proposer, pool, checker, cfg["instantiate"], seed), "c")]),
+        instantiate(plan, desk, [0], proposer, Kit(pool, checker), cfg["instantiate"], seed), "c")]),
         math.pi / 4)[0, 1])
     assert sum(faces(drawn, seed) for seed in SEEDS) < len(SEEDS) - 2
     partnered = FacingPartner(drawn, {("desk", "chair"): 1.0}, math.pi / 4, 16)
     assert all(faces(partnered, seed) for seed in SEEDS)
-    alone = lambda proposer, seed: placed(instantiate(plan, room, walls, [0], proposer, pool, checker,
+    alone = lambda proposer, seed: placed(instantiate(plan, room, [0], proposer, Kit(pool, checker),
                                                       cfg["instantiate"], seed), "c")
     assert all(np.array_equal(alone(drawn, seed), alone(partnered, seed)) for seed in SEEDS)
 
@@ -523,7 +523,7 @@ def test_a_chair_planned_in_front_of_a_desk_faces_it(learned, kind):
     proposer = proposer_of(kind, saved, cfg)
     plan = plan_of("c", "chair", [PlanEdge("desk", "c", "spatial", "front", "proximal")])
     for seed in SEEDS:
-        out = instantiate(plan, room, walls, [0], proposer, pool, checker, cfg["instantiate"], seed)
+        out = instantiate(plan, room, [0], proposer, Kit(pool, checker), cfg["instantiate"], seed)
         placed(out, "c")
         assert facing_angles(out.room.boxes)[0, 1] <= math.radians(45), (kind, seed, out.room.boxes[1])
 
@@ -622,8 +622,8 @@ def test_an_unsatisfiable_plan_ends_with_its_cause_and_no_relaxed_object():
                                        PlanEdge("bed", "n", "spatial", "right", "adjacent"),
                                        PlanEdge("bed", "n", "spatial", "front", "adjacent")])
     ic = {**cfg["instantiate"], "max_backtracks": 10, "backtracks_per_object": 0, "restarts": 0}
-    out = instantiate(plan, room, walls, [0], Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway()), pool,
-                      checker, ic, 0)
+    out = instantiate(plan, room, [0], Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway()), Kit(pool,
+                      checker), ic, 0)
     assert not out.ok and "no place for n (nightstand)" in out.reason and "refused most by" in out.reason
     assert out.relaxed == []
 
@@ -635,8 +635,8 @@ def test_an_object_kept_with_a_broken_relation_is_recorded_with_the_edge_and_why
 
     room, walls, pool, checker, cfg = setup_room(furnished(0))
     plan = plan_of("n", "nightstand", [PlanEdge(walls.ids[k], "n", "spatial", "front", "adjacent") for k in (2, 3, 0)])
-    out = instantiate(plan, room, walls, [0], Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway()), pool,
-                      checker, {**cfg["instantiate"], "restarts": 0}, 0)
+    out = instantiate(plan, room, [0], Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway()), Kit(pool,
+                      checker), {**cfg["instantiate"], "restarts": 0}, 0)
     assert out.ok, out.reason
     (rec,) = out.relaxed
     # the far wall is still seen in front, at a distance: half a violation of one of three relations
@@ -694,13 +694,13 @@ def test_forward_checking_refuses_a_place_that_leaves_a_later_object_none():
     room, walls, pool, checker, cfg = setup_room(furnished(0))
     plan, ic = _desk_and_chair(walls), cfg["instantiate"]
     proposer = Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway())
-    search = Search(plan, room, walls, [0, 1], proposer, pool, checker, ic, np.random.default_rng(0))
+    search = Search(plan, room, [0, 1], proposer, Kit(pool, checker), ic, np.random.default_rng(0))
     near = given(room, pool, "desk", "d", (2.2, 0.5 + 0.3 + 0.02), 180)
     middle = given(room, pool, "desk", "d", (2.2, 2.3), 180)
     assert search.forecloses(0, near, 0.0) is None
     assert search.forecloses(0, middle, 0.0) == set()
     assert search.forecloses(0, middle, 0.1) is None
-    mode = lambda m: Search(plan, room, walls, [0, 1], proposer, pool, checker, {**ic, "lookahead": m},
+    mode = lambda m: Search(plan, room, [0, 1], proposer, Kit(pool, checker), {**ic, "lookahead": m},
                             np.random.default_rng(0))
     assert mode("none").forecloses(0, middle, 0.0) is None
     assert mode("always").forecloses(0, middle, 0.1) == set() and mode("always").forecloses(0, near, 0.1) is None
@@ -714,7 +714,7 @@ def test_with_forward_checking_the_chair_keeps_both_relations():
 
     room, walls, pool, checker, cfg = setup_room(furnished(0))
     plan, proposer = _desk_and_chair(walls), Combined(RelationPrior(cfg["extract"], soft=1e-3), FaceAway())
-    run = lambda look: [instantiate(plan, room, walls, [0, 1], proposer, pool, checker,
+    run = lambda look: [instantiate(plan, room, [0, 1], proposer, Kit(pool, checker),
                                     {**cfg["instantiate"], "lookahead": look}, seed) for seed in range(20)]
     with_look, without = run("at_zero_tolerance"), run("none")
     assert all(o.ok for o in with_look + without)

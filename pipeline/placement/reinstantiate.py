@@ -14,7 +14,7 @@ from .layout import walls_of, with_objects
 from .plan import plans_from_tables
 from .proposers import Combined, FaceAway, RelationPrior
 from .retrieval import ModelPool
-from .search import instantiate
+from .search import Kit, instantiate
 
 
 def own_plans(nodes: pd.DataFrame, edges: pd.DataFrame, distances=("adjacent",)):
@@ -42,8 +42,8 @@ def reinstantiate(frames: dict[str, pd.DataFrame], models: tuple[dict, set, dict
             continue
         room = with_objects(inputs[plan.room_id], [])
         walls = walls_of(room)
-        out = instantiate(plan, room, walls, order.placement_order(plan, areas), Combined(RelationPrior(config["extract"]), FaceAway()),
-                          pool, checker, ic, seed)
+        out = instantiate(plan, room, order.placement_order(plan, areas),
+                          Combined(RelationPrior(config["extract"]), FaceAway()), Kit(pool, checker), ic, seed)
         m = scene_metrics.consistency(plan, out.room, walls.ids, checker)
         rows.append({"room_id": plan.room_id, "objects": len(plan.ids), "placed": out.status == "placed", "reason": out.reason,
                      "seconds": out.seconds, "backtracks": out.backtracks, "attempts": out.attempts, **m,

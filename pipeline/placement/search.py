@@ -30,7 +30,7 @@ import logging
 import time
 from collections import Counter
 from dataclasses import dataclass, field, replace
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -39,7 +39,7 @@ from ..geometry.relations import in_footprint
 from ..room import RoomInput, Walls
 from .anchors import Anchor, anchors_of, planned_edges
 from .checks import Checker, check
-from .layout import add_object, with_objects
+from .layout import add_object, walls_of, with_objects
 from .order import chains
 from .plan import ScenePlan
 from .proposers import Grid, RelationPrior, Request, gap_thresholds
@@ -143,17 +143,24 @@ def _in_box(points: np.ndarray, b: np.ndarray, inset=(0.0, 0.0), least: float = 
     return out if np.ndim(b) == 2 else out[0]
 
 
-class Search:
-    """One scene's search state."""
+class Kit(NamedTuple):
+    """What the search places with: the model ``pool`` it draws each object's instance from and the ``checker`` that
+    accepts a place."""
+    pool: ModelPool
+    checker: Checker
 
-    def __init__(self, plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer,
-                 pool: ModelPool, checker: Checker, cfg: dict, rng: np.random.Generator):
-        self.plan, self.walls, self.order = plan, walls, order
-        self.proposer, self.pool, self.checker, self.cfg, self.rng = proposer, pool, checker, cfg, rng
+
+class Search:
+    """One scene's search state (the room's walls: :func:`~pipeline.placement.layout.walls_of`)."""
+
+    def __init__(self, plan: ScenePlan, room: RoomInput, order: list[int], proposer: Proposer, kit: Kit, cfg: dict,
+                 rng: np.random.Generator):
+        self.plan, self.walls, self.order = plan, walls_of(room), order
+        self.proposer, self.pool, self.checker, self.cfg, self.rng = proposer, kit.pool, kit.checker, cfg, rng
         self.fixed = len(room.object_ids)  # objects given (completion) are never moved
         self.room = room
         self.grid = Grid(room.outline, cfg["grid_mpp"])
-        self.bands = RelationPrior(checker.extract_cfg, slack=cfg["band_slack"])
+        self.bands = RelationPrior(kit.checker.extract_cfg, slack=cfg["band_slack"])
         self.sym = dict(zip(plan.ids, plan.symmetry)) | {o: "none" for o in room.object_ids if o not in plan.ids}
         self.rejected: dict[str, list[tuple[float, float, float]]] = {}  # plan id -> (x, y, half side) of squares
         self.shared: dict[tuple, object] = {}
@@ -479,15 +486,15 @@ def drop_reason(drops: list[dict], planned: int) -> str:
         f"{DROP_CAUSES[c]}: {ids}" for c, ids in by_cause.items() if ids)
 
 
-def instantiate(plan: ScenePlan, room: RoomInput, walls: Walls, order: list[int], proposer: Proposer, pool: ModelPool,
-                checker: Checker, cfg: dict, seed: int) -> Outcome:
+def instantiate(plan: ScenePlan, room: RoomInput, order: list[int], proposer: Proposer, kit: Kit, cfg: dict,
+                seed: int) -> Outcome:
     """Place the plan's objects (``order``: indices into the plan) in ``room`` (its objects stay fixed), each with
-    the pose the proposer gives it. A search that spends its backtrack budget starts over, up to
-    ``cfg['restarts']`` times: attempt ``a > 0`` draws from ``(seed, a)``, so the first attempt is the search without
-    restarts. Counts and seconds add up over attempts."""
+    the pose the proposer gives it and an instance of the ``kit``'s pool its checker accepts. A search that spends its
+    backtrack budget starts over, up to ``cfg['restarts']`` times: attempt ``a > 0`` draws from ``(seed, a)``, so the
+    first attempt is the search without restarts. Counts and seconds add up over attempts."""
     start, runs = time.perf_counter(), []
     for attempt in range(cfg["restarts"] + 1):
-        s = Search(plan, room, walls, order, proposer, pool, checker, cfg,
+        s = Search(plan, room, order, proposer, kit, cfg,
                    np.random.default_rng(seed if attempt == 0 else [seed, attempt]))
         reason = s.run(time.perf_counter() + cfg["time_budget"])
         runs.append(s)

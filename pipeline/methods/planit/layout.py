@@ -20,7 +20,7 @@ from ...placement.facing import learn_anchor_facing, learn_facing_partners
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
-from ...placement.search import SCORED, instantiate
+from ...placement.search import SCORED, Kit, instantiate
 from ...placement.support import Window, learn_centring
 from ...placement.walls import learn_wall_backs
 from ...seeding import seed_of
@@ -127,7 +127,7 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
     fixed = [plan.ids[k] for k in seq[:keep]]
     start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
     walls = walls_of(start)
-    return instantiate(plan, start, walls, seq[keep:], proposer, ctx.pool, ctx.checker, cfg, seed), walls
+    return instantiate(plan, start, seq[keep:], proposer, Kit(ctx.pool, ctx.checker), cfg, seed), walls
 
 
 def select_plans(config: dict, variant: dict, corpus: Corpus, nodes: Path, edges: Path, count: int) -> list[ScenePlan]:
