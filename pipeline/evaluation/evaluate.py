@@ -30,8 +30,7 @@ def evaluate_room_type(config: dict[str, Any], room_type: str, gen: list[RoomSet
                        models: tuple[dict[str, Any], set[str], dict[str, str]],
                        threads: int = 1) -> tuple[dict[str, Any], pd.DataFrame]:
     """``metrics.json``'s content and the ``eval_scenes`` rows of every set (``gen``: the methods' sets, the first
-    one the reference of the differences and the goals); ``models``: meshes by model id, the box-only model ids and
-    the symmetry type by model id."""
+    the reference of the differences and goals; ``models``: meshes, box-only model ids, model -> symmetry type)."""
     meshes, box_models, symmetry = models
     ev = config["evaluate"]
     index = {c: k for k, c in enumerate(sorted({c for s in (train, real, *gen) for r in s.rooms for c in r.categories}))}
