@@ -18,6 +18,7 @@ from pipeline.placement.checks import Checker
 from pipeline.placement.layout import walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.retrieval import ModelPool
+from pipeline.placement.search import Kit
 
 from conftest import Room, default_config
 
@@ -178,7 +179,7 @@ def test_assembly_puts_each_object_at_its_tagged_cluster_and_keeps_the_planned_g
     pool, checker, cfg = _checker_pool()
     plan = plan_of(g)
     start = with_objects(r.room_input(), [])
-    outcome, walls, unanchored = assemble.assemble(plan, start, tags, pool, checker, cfg["strings"]["tagger"]["placement"],
+    outcome, walls, unanchored = assemble.assemble(plan, start, tags, Kit(pool, checker), cfg["strings"]["tagger"]["placement"],
                                                    cfg["instantiate"], seed)
     room = outcome.room
     assert outcome.dropped == [] and unanchored == 0 and sorted(room.object_ids) == sorted(plan.ids)
@@ -216,7 +217,7 @@ def test_an_object_no_try_can_place_is_left_out_with_what_it_supports():
     pool, checker, cfg = _checker_pool()
     plan = plan_of(g)
     pc = {**cfg["strings"]["tagger"]["placement"], "tries": 3, "min_jitter": 0.0}
-    outcome, _, _ = assemble.assemble(plan, with_objects(r.room_input(), []), tags, pool, checker, pc, cfg["instantiate"], 0)
+    outcome, _, _ = assemble.assemble(plan, with_objects(r.room_input(), []), tags, Kit(pool, checker), pc, cfg["instantiate"], 0)
     causes = {d["id"]: d["cause"] for d in outcome.drops}
     assert causes["ns_l"] == "no_place" and causes["lamp_l"] == "support_dropped"
     assert "bed" in outcome.room.object_ids and "dropped" in outcome.reason and outcome.status == "partial"

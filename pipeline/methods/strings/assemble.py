@@ -22,12 +22,12 @@ import numpy as np
 
 from ...graphs.data import edge_class
 from ...placement.anchors import anchors_of, planned_edges
-from ...placement.checks import Checker, check
+from ...placement.checks import check
 from ...placement.layout import add_object, walls_of
 from ...placement.plan import PlanEdge, ScenePlan
 from ...placement.proposers import Grid
-from ...placement.retrieval import ModelPool, place
-from ...placement.search import Outcome, drop_reason, inside_walls, snap
+from ...placement.retrieval import place
+from ...placement.search import Kit, Outcome, drop_reason, inside_walls, snap
 from ...room import RoomInput, Walls
 from .poses import anchor_frame, from_relative
 
@@ -107,9 +107,10 @@ def pose_of(p: Placing, tag: Tag, room: RoomInput, walls: Walls) -> tuple[np.nda
 class Assembly:
     """One scene's assembly state: the room so far, the counts, the dropped objects."""
 
-    def __init__(self, plan: ScenePlan, room: RoomInput, walls: Walls, tags: dict, pool: ModelPool, checker: Checker,
-                 cfg: dict, icfg: dict, rng: np.random.Generator):
-        self.plan, self.room, self.walls, self.tags, self.pool, self.checker = plan, room, walls, tags, pool, checker
+    def __init__(self, plan: ScenePlan, room: RoomInput, tags: dict, kit: Kit, cfg: dict, icfg: dict,
+                 rng: np.random.Generator):
+        self.plan, self.room, self.walls, self.tags = plan, room, walls_of(room), tags
+        self.pool, self.checker = kit
         self.cfg, self.rng, self.snap_cfg, self.mpp = cfg, rng, icfg["snap"], icfg["grid_mpp"]
         self.sym = dict(zip(plan.ids, plan.symmetry))
         self.insertions = self.rejections = self.unanchored = 0
@@ -192,17 +193,17 @@ class Assembly:
                 self.drop(k, "no_place")
 
 
-def assemble(plan: ScenePlan, room: RoomInput, tags: dict, pool: ModelPool, checker: Checker, cfg: dict,
-             icfg: dict, seed: int) -> tuple[Outcome, Walls, int]:
-    """Place the plan's objects in ``room`` (its architecture); ``tags``: plan edge key (:func:`key`) -> its clusters
-    ranked; ``cfg``: ``strings.tagger.placement``; ``icfg``: the ``instantiate`` section (snapping, grid). Returns the
-    outcome (the search's record: no backtracks), the walls and the objects placed with no
-    anchor."""
-    start, walls = time.perf_counter(), walls_of(room)
-    a = Assembly(plan, room, walls, tags, pool, checker, cfg, icfg, np.random.default_rng(seed))
+def assemble(plan: ScenePlan, room: RoomInput, tags: dict, kit: Kit, cfg: dict, icfg: dict,
+             seed: int) -> tuple[Outcome, Walls, int]:
+    """Place the plan's objects in ``room`` (its architecture) with the ``kit``'s instances and checker; ``tags``: plan
+    edge key (:func:`key`) -> its clusters ranked; ``cfg``: ``strings.tagger.placement``; ``icfg``: the
+    ``instantiate`` section (snapping, grid). Returns the outcome (the search's record: no backtracks), the walls and
+    the objects placed with no anchor."""
+    start = time.perf_counter()
+    a = Assembly(plan, room, tags, kit, cfg, icfg, np.random.default_rng(seed))
     a.run()
     reason = drop_reason(a.drops, len(plan.ids)) if a.dropped else ""
     outcome = Outcome(True, a.room, reason, time.perf_counter() - start, a.insertions, a.rejections, 0, a.failures,
                       a.dropped, a.drops, 1, a.accepted)
-    return outcome, walls, a.unanchored
+    return outcome, a.walls, a.unanchored
 

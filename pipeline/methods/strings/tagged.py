@@ -17,6 +17,7 @@ from ...learning import checkpoint
 from ...log import progress
 from ...placement.layout import with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
+from ...placement.search import Kit
 from ...seeding import seed_of
 from ..interface import Scene, Task
 from ..placing import load_context, scene_of
@@ -87,7 +88,7 @@ class TaggedLayout:
             seed = seed_of(self.config["seed"], self.name, plan.scene_id)
             tags = tags_of(graphs[plan.scene_id], vocab, clusters, model, tokens, rec["preset"]["votes"], seed)
             source = ctx.corpus.inputs[plan.room_id]
-            outcome, walls, unanchored = assemble(plan, with_objects(source, []), tags, ctx.pool, ctx.checker, pc,
+            outcome, walls, unanchored = assemble(plan, with_objects(source, []), tags, Kit(ctx.pool, ctx.checker), pc,
                                                   self.config["instantiate"], seed)
             scene = scene_of(plan, ctx, outcome, walls)
             scene.record["unanchored_objects"] = unanchored
