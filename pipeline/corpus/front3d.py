@@ -235,7 +235,7 @@ def _room(house: House, rid: str, room: dict, path: str, ctx: Context):
         return None, "no furniture with a mesh or box inside the floor outline"
     segs = polygon_segments(outline)
     _report_walls(segs, [_mesh_xyz(house, m)[:, :2] for m in room_meshes if m[1].get("type") == "WallInner"], cfg, ctx.ledger)
-    return {"rooms": [room_row(rid, "front3d", rtype, rtype_src, outline, height, len(objects))],
+    return {"rooms": [room_row(rid, "front3d", (rtype, rtype_src), outline, height, len(objects))],
             "architecture": wall_rows(rid, outline, height, cfg["wall_thickness"])
             + _openings(rid, house, room_meshes, segs, floor_z, cfg),
             "objects": [dict(o, object_id=f"obj_{k:02d}") for k, o in enumerate(objects)]}, ""
@@ -290,7 +290,7 @@ def _openings(rid: str, house: House, room_meshes: list, segs: np.ndarray, floor
         p0, p1 = segment_interval(xyz[:, :2], segs[w])
         if np.linalg.norm(p1 - p0) < cfg["opening_min_width"]:
             continue
-        rows.append(opening_row(rid, kind, counts[kind], p0, p1, xyz[:, 2].min() - floor_z, xyz[:, 2].max() - floor_z,
+        rows.append(opening_row(rid, kind, counts[kind], (p0, p1), (xyz[:, 2].min() - floor_z, xyz[:, 2].max() - floor_z),
                                 f"wall_{w}"))
         counts[kind] += 1
     return rows

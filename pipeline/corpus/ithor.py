@@ -98,7 +98,7 @@ def parse_room(group: str, index: int, objects: list[dict], cfg: dict, report: C
             out["models"].append(box_model_row(row["model_id"], row["category"], "ithor", [-row["hx"], -row["hy"], 0.0],
                                                [row["hx"], row["hy"], 2 * row["hz"]]))
     out["ground_truth"] = _support_truth(rid, out["objects"], objects, ids, report)
-    out["rooms"].append(room_row(rid, "ithor", room_type, group, outline, HEIGHT, len(out["objects"])))
+    out["rooms"].append(room_row(rid, "ithor", (room_type, group), outline, HEIGHT, len(out["objects"])))
     report[("room", "read", room_type)] += 1
     return out
 
@@ -209,7 +209,8 @@ def _face_away_from_wall(yaw, centre, half, corners, outline):
 def _window(rid: str, k: int, corners: np.ndarray, segs: np.ndarray, floor_z: float) -> dict:
     w = int(nearest_segment(corners[:, :2].mean(axis=0), segs)[1])
     p0, p1 = segment_interval(corners[:, :2], segs[w])
-    return opening_row(rid, "window", k, p0, p1, corners[:, 2].min() - floor_z, corners[:, 2].max() - floor_z, f"wall_{w}")
+    return opening_row(rid, "window", k, (p0, p1), (corners[:, 2].min() - floor_z, corners[:, 2].max() - floor_z),
+                       f"wall_{w}")
 
 
 def load(cfg: dict) -> tuple[dict, Path]:

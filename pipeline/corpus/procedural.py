@@ -192,7 +192,7 @@ class RoomBuilder:
 
     def _opening(self, kind: str, k: int, wall: Wall, s: float, width: float, z0: float, z1: float) -> None:
         p0 = wall.a + wall.dir * s
-        self.arch.append(opening_row(self.room_id, kind, k, p0, p0 + wall.dir * width, z0, z1, wall.element_id))
+        self.arch.append(opening_row(self.room_id, kind, k, (p0, p0 + wall.dir * width), (z0, z1), wall.element_id))
 
     # ------------------------------------------------------------------ objects
     def model(self, category: str, variant: int | None = None) -> Model:
@@ -687,7 +687,7 @@ def _apply_defect(r: RoomBuilder, defect: str) -> None:
 
 def room_tables(r: RoomBuilder) -> tuple[dict, list[dict], list[dict], list[dict]]:
     """Rows of the canonical tables for one generated room."""
-    room = room_row(r.room_id, "procedural", r.room_type, r.room_type, r.outline, r.height, len(r.objects))
+    room = room_row(r.room_id, "procedural", (r.room_type, r.room_type), r.outline, r.height, len(r.objects))
     objs = []
     for o in r.objects:
         objs.append({"room_id": r.room_id, "object_id": o.object_id, "category": o.category, "model_id": o.model.model_id,

@@ -11,9 +11,11 @@ from ..geometry import meshes as M
 from ..geometry.polygon import extents, polygon_segments, signed_area
 
 
-def room_row(room_id: str, source: str, room_type: str, source_room_type: str, outline: np.ndarray, height: float,
-             n_objects: int, shard: int | None = None) -> dict:
-    """A ``rooms`` row; ``outline`` is the (k, 2) counter-clockwise floor outline."""
+def room_row(room_id: str, source: str, types: tuple[str, str], outline: np.ndarray, height: float, n_objects: int,
+             shard: int | None = None) -> dict:
+    """A ``rooms`` row; ``types``: its room type and the source's own; ``outline`` is the (k, 2) counter-clockwise
+    floor outline."""
+    room_type, source_room_type = types
     outline = np.asarray(outline, float)
     ex, ey = extents(outline)
     return {"room_id": room_id, "source": source, "room_type": room_type, "source_room_type": source_room_type,
@@ -29,8 +31,10 @@ def wall_rows(room_id: str, outline: np.ndarray, height: float, thickness: float
              "wall_id": None} for i, s in enumerate(polygon_segments(outline))]
 
 
-def opening_row(room_id: str, kind: str, k: int, p0, p1, z0: float, z1: float, wall_id: str) -> dict:
-    """A door or window (``<kind>_<k>``) from ``p0`` to ``p1`` (2,) along wall ``wall_id``."""
+def opening_row(room_id: str, kind: str, k: int, ends: tuple, span: tuple[float, float], wall_id: str) -> dict:
+    """A door or window (``<kind>_<k>``) from ``p0`` to ``p1`` (``ends``, each (2,)) along wall ``wall_id``, from
+    height ``z0`` to ``z1`` (``span``, m)."""
+    (p0, p1), (z0, z1) = ends, span
     return {"room_id": room_id, "element_id": f"{kind}_{k}", "kind": kind, "x0": float(p0[0]), "y0": float(p0[1]),
             "x1": float(p1[0]), "y1": float(p1[1]), "z0": float(z0), "z1": float(z1), "thickness": None, "wall_id": wall_id}
 

@@ -106,6 +106,6 @@ def _room(out, house_id, room, nodes, floor, scale, rtype, categories, report) -
                         "model_id": mid, "cx": c[0], "cy": c[1], "cz": c[2], "hx": ext[0] / 2, "hy": ext[1] / 2,
                         "hz": ext[2] / 2, "yaw": yaw, "px": c[0], "py": c[1], "pz": c[2] - ext[2] / 2, "sx": 1.0, "sy": 1.0,
                         "sz": 1.0, "source_parent_id": None})
-    out["rooms"].append(room_row(room_id, "suncg", rtype, ",".join(room.get("roomTypes", [])), outline, height, len(objects)))
+    out["rooms"].append(room_row(room_id, "suncg", (rtype, ",".join(room.get("roomTypes", []))), outline, height, len(objects)))
     out["objects"] += objects
     report[("room", "read", rtype)] += 1

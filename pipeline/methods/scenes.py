@@ -60,7 +60,7 @@ class Rows:
         """The rooms row and wall rows of a scene whose method decoded its own walls (``scene.room``'s outline)."""
         room = scene.room
         source = str(corpus.rooms["source"].iloc[0]) if len(corpus.rooms) else "generated"
-        self.rooms.append(room_row(scene.scene_id, source, corpus.room_type, corpus.room_type, room.outline,
+        self.rooms.append(room_row(scene.scene_id, source, (corpus.room_type, corpus.room_type), room.outline,
                                    room.height, len(room.object_ids), shard=0))
         self.architecture += wall_rows(scene.scene_id, room.outline, room.height,
                                        float(np.median(room.wall_thickness)))
