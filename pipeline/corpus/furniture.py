@@ -39,7 +39,19 @@ def cabinet(w, d, h, rng, handles=2):
     return parts
 
 
-def seat(w, d, h, rng, back=True, arms=False, seat_h=0.45, soft=False):
+@dataclass(frozen=True)
+class SeatStyle:
+    """A seat's build: a back, arms, the seat's height (m; None: the whole height, a stool-like top) and a soft
+    (upholstered block) or hard (slab on legs) seat."""
+    back: bool = True
+    arms: bool = False
+    seat_h: float | None = 0.45
+    soft: bool = False
+
+
+def seat(w, d, h, rng, style: SeatStyle = SeatStyle()):
+    back, arms, soft = style.back, style.arms, style.soft
+    seat_h = h if style.seat_h is None else style.seat_h
     parts = []
     if soft:
         parts.append(M.box((w, d, seat_h), (0, 0, seat_h / 2)))
@@ -155,10 +167,10 @@ def bowl(w, d, h, rng):
 TEMPLATES = {
     "table": table, "round_table": lambda w, d, h, rng: table(w, w, h, rng, round_top=True),
     "cabinet": cabinet, "cabinet1": lambda w, d, h, rng: cabinet(w, d, h, rng, handles=1),
-    "chair": seat, "armchair": lambda w, d, h, rng: seat(w, d, h, rng, arms=True, soft=True, seat_h=0.42),
-    "sofa": lambda w, d, h, rng: seat(w, d, h, rng, arms=True, soft=True, seat_h=0.42),
-    "ottoman": lambda w, d, h, rng: seat(w, d, h, rng, back=False, soft=True, seat_h=h),
-    "bench": lambda w, d, h, rng: seat(w, d, h, rng, back=False, seat_h=h),
+    "chair": seat, "armchair": lambda w, d, h, rng: seat(w, d, h, rng, SeatStyle(arms=True, seat_h=0.42, soft=True)),
+    "sofa": lambda w, d, h, rng: seat(w, d, h, rng, SeatStyle(arms=True, seat_h=0.42, soft=True)),
+    "ottoman": lambda w, d, h, rng: seat(w, d, h, rng, SeatStyle(back=False, seat_h=None, soft=True)),
+    "bench": lambda w, d, h, rng: seat(w, d, h, rng, SeatStyle(back=False, seat_h=None)),
     "stool": stool, "bed": bed, "screen": screen, "monitor": screen,
     "lamp": lamp, "plant": plant, "vessel": vessel, "appliance": appliance, "stove": stove,
     "shelf": shelf, "desk": desk, "toilet": toilet, "bathtub": bathtub, "rack": rack, "block": block,
