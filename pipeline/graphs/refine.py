@@ -215,7 +215,7 @@ def _repair_connectivity(edges: list[dict], idx: dict, cfg: dict) -> int:
         path = None
         for allow_cycles in (False, True):  # any acyclic path beats every cycle-creating one
             for allowed in tiers:
-                path = _cheapest_path(edges, idx, kept, reach, target, allowed, allow_cycles, cc)
+                path = _cheapest_path(edges, idx, (kept, reach), target, (allowed, allow_cycles), cc)
                 if path:
                     break
             if path:
@@ -236,7 +236,11 @@ def _repair_connectivity(edges: list[dict], idx: dict, cfg: dict) -> int:
     return repaired
 
 
-def _cheapest_path(edges, idx, kept, reach, target, allowed, allow_cycles, cc) -> list[dict] | None:
+def _cheapest_path(edges: list[dict], idx: dict, sofar: tuple, target: str, tier: tuple,
+                   cc: dict) -> list[dict] | None:
+    """The cheapest pruned edges that join ``target`` to what ``sofar`` (the kept graph, the nodes it reaches) reaches,
+    among the ``tier``'s (edge kinds allowed, whether a path may close a cycle); None: none."""
+    (kept, reach), (allowed, allow_cycles) = sofar, tier
     g = nx.DiGraph()
     costs = cc["costs"]
     for e in edges:
