@@ -87,8 +87,8 @@ def test_a_fixed_temperature_chain_samples_the_boltzmann_variance():
     energy = Energy(Hard(state, LIMITS), [Term("quadratic", 1.0, lambda s: 0.5 * (s.boxes[0, 0] - 30.0) ** 2)])
     cfg = {"schedule": {"kind": "constant", "t0": 0.5}, "moves": {"start": {"translate": 1.0}, "end": {}}}
     v, e, _ = energy(state)
-    chain = anneal(Chain(state, (v, e), state, (v, e)), energy, Proposer(spec, p, Steps(2.0, 0.01, 1.0, 0.0)),
-                   {"box"}, 30000, cfg, np.random.default_rng(1), record_every=1)
+    chain = anneal(Chain(state, (v, e), state, (v, e)), (energy, Proposer(spec, p, Steps(2.0, 0.01, 1.0, 0.0))),
+                   {"box"}, 30000, cfg, np.random.default_rng(1), ("", 1))
     x = np.array([30.0 + np.sqrt(2 * row["energy"]) for row in chain.trace[2000:]])  # |x - 30|: the variance of x
     assert np.mean((x - 30.0) ** 2) == pytest.approx(0.5, rel=0.05)
 
@@ -183,7 +183,7 @@ def test_the_saog_wall_distance_chain_reproduces_its_log_normal():
     rng = np.random.default_rng(3)
     proposer = Proposer({"box": Spec("box", (1, 1), "all", "floor")}, p, Steps(0.3, 0.3, 0.3, 0.0))
     for _ in range(1500):  # 20 moves between draws
-        chain = anneal(chain, energy, proposer, {"box"}, 20, cfg, rng, record_every=1000)
+        chain = anneal(chain, (energy, proposer), {"box"}, 20, cfg, rng, ("", 1000))
         backs.append(chain.state.boxes[0, 0] - 0.05)
     assert stats.kstest(backs[100:], stats.lognorm(s=sigma, scale=np.exp(mu)).cdf).pvalue > 0.01
 

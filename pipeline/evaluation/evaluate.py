@@ -27,11 +27,11 @@ EXTRA = ["consistency", "violation", "nn_similarity", "contents_excess", "conten
 
 
 def evaluate_room_type(config: dict[str, Any], room_type: str, gen: list[RoomSet], train: RoomSet, real: RoomSet,
-                       models: tuple[dict[str, Any], set[str], dict[str, str]], threads: int = 1) -> tuple[dict, pd.DataFrame]:
+                       models: tuple[dict[str, Any], set[str], dict[str, str]],
+                       threads: int = 1) -> tuple[dict[str, Any], pd.DataFrame]:
     """``metrics.json``'s content and the ``eval_scenes`` rows of every set (``gen``: the methods' sets, the first
     the reference of the differences and goals; ``models``: meshes, box-only model ids, model -> symmetry type)."""
-    meshes, box_models, symmetry = models
-    ev = config["evaluate"]
+    meshes, box_models, symmetry, ev = *models, config["evaluate"]
     index = {c: k for k, c in enumerate(sorted({c for s in (train, real, *gen) for r in s.rooms for c in r.categories}))}
     train_maps = label_maps(train, index, ev["render"])
     learned = functional.learn_checks(train.rooms, ev["functional"], symmetry)

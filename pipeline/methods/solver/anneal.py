@@ -33,10 +33,13 @@ def accept(old: tuple[int, float], new: tuple[int, float], temp: float, rng: np.
     return new[1] <= old[1] or rng.random() < np.exp((old[1] - new[1]) / max(temp, 1e-12))
 
 
-def anneal(chain: Chain, energy: Energy, proposer: Proposer, active: set[str], steps: int, cfg: dict,
-           rng: np.random.Generator, stage: str = "", record_every: int = 10) -> Chain:
-    """Propose ``steps`` moves on the items of the ``active`` categories (``cfg``: the ``solver`` section: schedule, move
-    weights at the start and end); keeps the best state seen."""
+def anneal(chain: Chain, moves: tuple[Energy, Proposer], active: set[str], steps: int, cfg: dict,
+           rng: np.random.Generator, record: tuple[str, int] = ("", 10)) -> Chain:
+    """Propose ``steps`` moves (``moves``: the energy and the proposer) on the items of the ``active`` categories
+    (``cfg``: the ``solver`` section: schedule, move weights at the start and end); keeps the best state seen;
+    ``record``: the stage's name in the trace and how many steps apart it records one."""
+    energy, proposer = moves
+    stage, record_every = record
     names = list(MOVES)
     t = tries = 0
     while t < steps and tries < 10 * steps:  # a step is a proposed move: moves that do not apply are drawn again
@@ -104,5 +107,5 @@ def solve(state: State, specs: dict[str, Spec], energy: Energy, proposer: Propos
         v, e, _ = energy(start)
         chain.state, chain.score = start, (v, e)
         chain.best, chain.best_score = start, (v, e)
-        chain = anneal(chain, energy, proposer, active, int(cfg["steps"][stage]), cfg, rng, stage)
+        chain = anneal(chain, (energy, proposer), active, int(cfg["steps"][stage]), cfg, rng, (stage, 10))
     return chain
