@@ -38,7 +38,7 @@ def draw(net, tokens, vocab, held, rules, n, cfg, mask: str, seed: int) -> tuple
     start = time.perf_counter()
     z = decoding.prior_codes(n, net.to_mu.out_features, gen)
     masker = R.masker(tokens, n, rules, mask)
-    rows = decoding.decode(net, z, R.prefixes(rooms, vocab, tokens), tokens, cfg["max_length"], cfg["temperature"], gen,
+    rows = decoding.decode(net, z, R.prefixes(rooms, vocab, tokens), tokens, (cfg["max_length"], cfg["temperature"], gen),
                            masker)
     seconds = time.perf_counter() - start
     judged = R.verdicts(rows, rooms, tokens, vocab, rules, masker)
@@ -55,8 +55,8 @@ def interpolation(net, tokens, vocab, held, rules, cfg, pairs: int) -> float:
         a, b = rng.choice(len(held), 2, replace=False)
         z = decoding.path_codes(mu[a], mu[b], 32)
         masker = R.masker(tokens, 32, rules, cfg["mask"])
-        rows = decoding.decode(net, z, R.prefixes([held[a]] * 32, vocab, tokens), tokens, cfg["max_length"], 0.0,
-                               torch.Generator().manual_seed(0), masker)
+        rows = decoding.decode(net, z, R.prefixes([held[a]] * 32, vocab, tokens), tokens,
+                               (cfg["max_length"], 0.0, torch.Generator().manual_seed(0)), masker)
         valid += [g is not None for g, _ in R.verdicts(rows, [held[a]] * 32, tokens, vocab, rules, masker)]
     return round(float(np.mean(valid)), 3)
 

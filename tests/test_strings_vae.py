@@ -46,7 +46,7 @@ def test_syntax_masked_decoding_writes_only_strings_that_parse():
     z = decoding.prior_codes(64, PRESET["latent"], gen)
 
     def parsed(syntax):
-        rows = decoding.decode(model, z, [prefix] * 64, vocab, 120, 1.0, gen, syntax)
+        rows = decoding.decode(model, z, [prefix] * 64, vocab, (120, 1.0, gen), syntax)
         ended = [vocab.decode(r) for r in rows if vocab.index[EOS] in r]
         ok = []
         for text in ended:
@@ -73,7 +73,7 @@ def test_the_grammar_mask_writes_only_graphs_the_training_grammar_holds():
     prefix = vocab.encode([arch_prefix(*ROOM)[0] + "."])[0, 1:-1].tolist()
     gen = torch.Generator().manual_seed(2)
     mask = decoding.Syntax(vocab, 32, {vocab.index["[wall]"]}, grammar, {"bed": 1, "nightstand": 1, "table_lamp": 1})
-    rows = decoding.decode(model, decoding.prior_codes(32, PRESET["latent"], gen), [prefix] * 32, vocab, 120, 1.0, gen,
+    rows = decoding.decode(model, decoding.prior_codes(32, PRESET["latent"], gen), [prefix] * 32, vocab, (120, 1.0, gen),
                            mask)
     graphs = [parse(vocab.decode(r)) for k, r in enumerate(rows) if vocab.index[EOS] in r and k not in mask.dead]
     assert graphs and all(grammar.valid(g) and g.names.count("bed") <= 1 for g in graphs)
@@ -100,7 +100,7 @@ def test_a_room_learned_by_heart_decodes_back_from_its_code(tmp_path):
     text = serialize_room(*ROOM)
     mu = decoding.encode_means(run.model, [text], vocab, 200)
     prefix = vocab.encode([arch_prefix(*ROOM)[0] + "."])[0, 1:-1].tolist()
-    rows = decoding.decode(run.model, mu, [prefix], vocab, 200, 0.0, torch.Generator().manual_seed(0),
+    rows = decoding.decode(run.model, mu, [prefix], vocab, (200, 0.0, torch.Generator().manual_seed(0)),
                            decoding.Syntax(vocab, 1))
     assert isomorphic(parse(vocab.decode(rows[0])), ROOM[0])
     path = decoding.path_codes(mu[0], torch.zeros_like(mu[0]), 32)

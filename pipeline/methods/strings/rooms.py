@@ -152,8 +152,8 @@ def _sample_valid(decoder: tuple, held: list[Graph], n: int, sc: dict, rules: Ru
         rooms = [held[i % len(held)] for i in part]
         z = decoding.prior_codes(len(part), net.to_mu.out_features, gen)
         syntax = masker(tokens, len(part), rules, sc["mask"])
-        rows = decoding.decode(net, z, prefixes(rooms, vocab, tokens), tokens, sc["max_length"], sc["temperature"],
-                               gen, syntax)
+        rows = decoding.decode(net, z, prefixes(rooms, vocab, tokens), tokens, (sc["max_length"], sc["temperature"], gen),
+                               syntax)
         return verdicts(rows, rooms, tokens, vocab, rules, syntax)
 
     return resample(n, sc["resample_budget"], sc["batch_size"], seed, draw, f"strings {room_type}")

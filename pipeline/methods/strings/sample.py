@@ -145,10 +145,12 @@ class Syntax:
         return self.grammar.fits(here, held[reader.current], mine) and self.grammar.fits(name, other, theirs)
 
 
-def decode(model: SeqVAE, z: torch.Tensor, prefixes: list[list[int]], vocab: TokenVocab, max_length: int,
-           temperature: float, gen: torch.Generator, syntax: Syntax | None = None) -> np.ndarray:
+def decode(model: SeqVAE, z: torch.Tensor, prefixes: list[list[int]], vocab: TokenVocab,
+           draw: tuple[int, float, torch.Generator], syntax: Syntax | None = None) -> np.ndarray:
     """``(n, <= max_length)`` token rows: ``<bos>``, each row's forced ``prefixes[k]`` tokens, then drawn tokens
-    until ``<eos>`` (temperature 0: the most likely) or ``max_length``; ``syntax`` masks what may not come next."""
+    until ``<eos>`` (temperature 0: the most likely) or ``max_length``; ``draw``: (max_length, temperature, the
+    generator drawn from); ``syntax`` masks what may not come next."""
+    max_length, temperature, gen = draw
     model.eval()
     ix, n = vocab.index, len(z)
     forced = np.zeros((n, max_length), np.int64)
