@@ -82,7 +82,7 @@ class SaogLayout:
         steps = self.cfg["presets"][self.cfg["preset"]]["steps"]
 
         def solve_one(state, hard, rng: np.random.Generator):
-            return sample_room(grammar, grammar["weights"], state, hard, ctx.pool, self.cfg, steps, rng)
+            return sample_room(grammar, grammar["weights"], (state, hard), ctx.pool, self.cfg, steps, rng)
 
         yield from solve_rooms(self.config, task, self.name, task.count or self.cfg["scenes"], solve_one,
                                ctx.checker.support_floor)

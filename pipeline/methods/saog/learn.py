@@ -162,7 +162,7 @@ def learn_weights(grammar: dict, states: list[State], rooms: list[RoomInput], po
         out = []
         for k in rng.choice(len(rooms), size=preset["cd_samples"]):
             state = empty_state(rooms[k], walls_of(rooms[k]))
-            chain = sample_room(grammar, weights, state, Hard(state, limits), pool, cfg, max(preset["steps"] // 10, 10), rng)
+            chain = sample_room(grammar, weights, (state, Hard(state, limits)), pool, cfg, max(preset["steps"] // 10, 10), rng)
             out.append(per_object(features(chain.best, grammar), chain.best))
         return np.array(out)
 

@@ -40,9 +40,11 @@ def specs_of(grammar: dict, counts: dict[str, int], pool: ModelPool) -> dict[str
             for c, n in counts.items() if n > 0 and pool.has(c)}
 
 
-def sample_room(grammar: dict, weights: dict, state: State, hard: Hard, pool: ModelPool, cfg: dict, steps: int,
+def sample_room(grammar: dict, weights: dict, room: tuple[State, Hard], pool: ModelPool, cfg: dict, steps: int,
                 rng: np.random.Generator) -> Chain:
-    """One sampled room in ``state``'s architecture (``cfg``: the saog section)."""
+    """One sampled room in the architecture of ``room`` (its empty state and hard constraints; ``cfg``: the saog
+    section)."""
+    state, hard = room
     specs = specs_of(grammar, parse_tree(grammar, rng), pool)
     s = cfg["step"]
     proposer = Proposer(specs, pool, Steps(s["scale"], s["least"], s["most"], np.deg2rad(s["quantum"])),
