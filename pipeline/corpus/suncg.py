@@ -15,10 +15,12 @@ import json
 import math
 from collections import Counter
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from .front3d import WORLD, HouseError, outline_of_triangles
+from .ledger import Ledger
 from .rows import box_model_row, room_row, wall_rows
 
 WALL_THICKNESS = 0.1  # m: house.json gives none
@@ -55,7 +57,7 @@ def parse_house(file: Path, room_folder: Path | None, report: Counter) -> dict[s
             if not floor.exists():
                 raise HouseError(file, f"room {room.get('id')}", f"architecture file {floor} not found (SUNCG's room "
                                  "meshes <room modelId>f.obj / w.obj / c.obj are a separate download; set suncg.room_folder)")
-            _room(out, house["id"], room, nodes, floor, scale, rtype, categories, report)
+            _room(out, _House(house["id"], scale, categories, report), room, nodes, floor, rtype)
     return out
 
 
@@ -67,8 +69,20 @@ def _categories(path: Path) -> dict[str, str]:
                 for r in csv.DictReader(fh) if r.get("model_id")}
 
 
-def _room(out, house_id, room, nodes, floor, scale, rtype, categories, report) -> None:
+class _House(NamedTuple):
+    """What every room of one house reads: its id, its scale to metres, the model -> category map, the ledger."""
+    id: str
+    scale: float
+    categories: dict[str, str]
+    report: Ledger
+
+
+def _room(out: dict, house: _House, room: dict, nodes: list, floor: Path, rtype: str) -> None:
+    """One room of a house level into ``out``'s tables: its floor mesh ``floor`` as outline and walls, the level's
+    ``nodes`` it indexes as objects of room type ``rtype``."""
     import trimesh
+
+    house_id, scale, categories, report = house
 
     mesh = trimesh.load(floor, force="mesh", process=False)
     v = np.asarray(mesh.vertices, float) * scale @ WORLD.T
