@@ -316,6 +316,13 @@ class Sideways:
         return req.anchors[0].frame.yaw + math.pi / 2
 
 
+class AnyTurn:
+    """Any turn, drawn uniformly."""
+
+    def orientation(self, req, xy, rng) -> float:
+        return float(rng.uniform(-math.pi, math.pi))
+
+
 def _desk_sideways(room: Room) -> Room:
     """``room`` with its desk turned a quarter turn, its side flush against the wall its back was against."""
     desk = room.room_input().boxes.reshape(-1, 7)[room.room_input().object_ids.index("desk")]
@@ -512,6 +519,17 @@ def test_objects_face_the_placed_objects_the_training_rooms_objects_face_where_t
     alone = lambda proposer, seed: placed(instantiate(plan, room, [0], proposer, Kit(pool, checker),
                                                       cfg["instantiate"], seed), "c")
     assert all(np.array_equal(alone(drawn, seed), alone(partnered, seed)) for seed in SEEDS)
+    # a partner planned against a wall but placed later stands in as that wall: the chair placed first, turned at
+    # random, faces the bottom wall its desk will stand against only with the rule
+    both = ScenePlan("s", "r0", "bedroom", ["c", "d"], ["chair", "desk"], ["left-right", "none"], [1, 1], [None, None],
+                     ["none", "none"], [PlanEdge(walls.ids[2], "c", "spatial", "front", "adjacent"),
+                                        PlanEdge(walls.ids[0], "d", "spatial", "front", "adjacent")])
+    turned = Combined(RelationPrior(cfg["extract"]), AnyTurn())
+    first = lambda proposer, seed: placed(instantiate(both, room, [0, 1], proposer, Kit(pool, checker),
+                                                      cfg["instantiate"], seed), "c")
+    down = lambda box: -math.cos(box[6]) >= math.cos(math.pi / 4)  # its front within 45 degrees of -y
+    assert sum(down(first(turned, seed)) for seed in SEEDS) < len(SEEDS) - 2
+    assert all(down(first(FacingPartner(turned, {("desk", "chair"): 1.0}, math.pi / 4, 16), seed)) for seed in SEEDS)
 
 
 @pytest.mark.slow

@@ -13,7 +13,7 @@ import numpy as np
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d
 from ..geometry.frames import to_local, to_world, turn_error
-from ..geometry.function import facing_each_other
+from ..geometry.function import facing_angles, facing_each_other
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
@@ -25,7 +25,8 @@ from .support import CentreLine, half_depth_on
 class Request:
     """The object being placed: its category and symmetry, its anchors (:class:`~pipeline.placement.anchors.Anchor`)
     in the room as it stands, the candidate centres (:class:`Grid`) and which of them are allowed ``mask (cells,)``
-    (on the floor or its support's top, off what stands there, outside rejected squares)."""
+    (on the floor or its support's top, off what stands there, outside rejected squares); ``ahead``: the plan's objects
+    not placed yet that have no planned edge to it, as (category, index of the wall it is planned adjacent to)."""
     room: RoomInput
     walls: Walls
     category: str
@@ -33,6 +34,7 @@ class Request:
     anchors: list[Anchor]
     grid: "Grid"
     mask: np.ndarray
+    ahead: tuple[tuple[str, int], ...] = ()
 
     @property
     def points(self) -> np.ndarray:
@@ -223,7 +225,9 @@ class FacingPartner:
     :func:`~pipeline.placement.facing.learn_facing_partners`): with the largest such share among the placed
     partners, the pose is drawn from the base proposer conditioned on facing one of them within ``facing`` rad
     (:func:`~pipeline.geometry.function.facing_each_other`), by drawing up to ``tries`` poses and keeping the first that
-    does (else the first drawn). A partner the object has a planned edge to is the plan's; an object on a support has
+    does (else the first drawn). With no partner placed yet, a partner the plan puts against a wall later
+    (:attr:`Request.ahead`: a sofa placed before its television stand) stands in as that wall: the object is drawn
+    facing the wall's segment. A partner the object has a planned edge to is the plan's; an object on a support has
     none."""
 
     def __init__(self, base, shares: dict[tuple[str, str], float], facing: float, tries: int):
@@ -231,25 +235,29 @@ class FacingPartner:
 
     def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
         first = self.base.pose(req, rng)
-        partners = self._partners(req)
-        if first is None or not len(partners):
+        if first is None or any(a.kind == SUPPORT for a in req.anchors):
             return first
-        share = max(self.shares[(req.room.categories[o], req.category)] for o in partners)
-        if rng.random() >= share:
+        partners, share, faces = self._partners(req), 0.0, self._faces
+        if len(partners):
+            share = max(self.shares[(req.room.categories[o], req.category)] for o in partners)
+        else:
+            later = [(self.shares[(c, req.category)], w) for c, w in req.ahead if (c, req.category) in self.shares]
+            if later:
+                share, wall = max(later)
+                partners, faces = np.array([wall]), self._faces_wall
+        if not share or rng.random() >= share:
             return first
         drawn: tuple[np.ndarray, float] | None = first
         for _ in range(self.tries):
             if drawn is None:
                 break
-            if self._faces(req, partners, *drawn):
+            if faces(req, partners, *drawn):
                 return drawn
             drawn = self.base.pose(req, rng)
         return first
 
     def _partners(self, req: Request) -> np.ndarray:
         """Indices of the placed objects of a partner category the plan gives the object no edge to."""
-        if any(a.kind == SUPPORT for a in req.anchors):
-            return np.zeros(0, int)
         planned = {req.room.categories[a.obj] for a in req.anchors if a.obj is not None}
         cats = req.room.categories
         return np.array([k for k, c in enumerate(cats) if (c, req.category) in self.shares and c not in planned], int)
@@ -257,6 +265,14 @@ class FacingPartner:
     def _faces(self, req: Request, partners: np.ndarray, xy: np.ndarray, yaw: float) -> bool:
         boxes = np.vstack([req.room.boxes.reshape(-1, 7)[partners], [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
         return bool(facing_each_other(boxes, self.facing)[:-1, -1].any())
+
+    def _faces_wall(self, req: Request, walls: np.ndarray, xy: np.ndarray, yaw: float) -> bool:
+        """The pose's front lies within ``facing`` of the direction to the nearest point of wall ``walls[0]``."""
+        w = int(walls[0])
+        mid, half = (req.walls.a[w] + req.walls.b[w]) / 2, req.walls.length[w] / 2
+        boxes = np.array([[mid[0], mid[1], 0.0, half, 1e-3, 0.0, wall_frame(req.walls, w).yaw],
+                          [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
+        return bool(facing_angles(boxes)[0, 1] <= self.facing)
 
 
 class Combined(DensityProposer):

@@ -303,7 +303,16 @@ class Search:
             mask &= (np.abs(self.grid.points[:, 0] - x) > r) | (np.abs(self.grid.points[:, 1] - y) > r)
         anchors = anchors_of(v, self.plan, self.room, self.walls, self.sym, half)
         return Request(self.room, self.walls, self.plan.categories[k], self.plan.symmetry[k], anchors, self.grid,
-                       mask), pk
+                       mask, self.ahead(v)), pk
+
+    def ahead(self, v: str) -> tuple[tuple[str, int], ...]:
+        """The plan's objects not placed yet with no planned edge to ``v``, as (category, wall index) of each wall it
+        is planned adjacent to (:attr:`~pipeline.placement.proposers.Request.ahead`)."""
+        placed, wall = set(self.room.object_ids), {w: k for k, w in enumerate(self.walls.ids)}
+        joined = {e.source if e.target == v else e.target for e in self.plan.edges if v in (e.source, e.target)}
+        return tuple((self.plan.categories[self.plan.index(e.target)], wall[e.source]) for e in self.plan.edges
+                     if e.source in wall and e.edge_type == "spatial" and e.distance == "adjacent"
+                     and e.target in self.plan.ids and e.target not in placed | joined | {v})
 
     def propose(self, k: int):
         """A candidate box and pose for object ``k``, or None when no allowed candidate has mass."""
