@@ -117,3 +117,31 @@ def test_the_layers_hold_and_a_breach_is_caught(tmp_path):
     out = _lint(tmp_path)
     assert out.returncode != 0 and "pipeline.geometry is not allowed to import pipeline.stages" in out.stdout
     assert "pipeline.stages.symmetry is not allowed to import pipeline.stages.ingest" in out.stdout
+
+
+MAX_LINES, MAX_PARAMETERS = 45, 7
+CLI_COMMANDS = {("pipeline/cli.py", "view")}  # a typer command's options are its command line, one parameter each
+
+
+def long_or_wide(source: str, path: str) -> list[str]:
+    """The functions of ``source`` over MAX_LINES lines or MAX_PARAMETERS parameters (``self``/``cls`` aside)."""
+    out = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and (path, node.name) not in CLI_COMMANDS:
+            a = node.args
+            names = [x.arg for x in (*a.posonlyargs, *a.args, *a.kwonlyargs)] + [x.arg for x in (a.vararg, a.kwarg) if x]
+            params = len([n for n in names if n not in ("self", "cls")])
+            lines = node.end_lineno - node.lineno + 1
+            if lines > MAX_LINES or params > MAX_PARAMETERS:
+                out.append(f"{path}:{node.lineno} {node.name}: {lines} lines, {params} parameters")
+    return out
+
+
+def test_no_function_runs_over_45_lines_or_takes_over_7_parameters():
+    found = [f for p in sorted((ROOT / "pipeline").rglob("*.py"))
+             for f in long_or_wide(p.read_text(), str(p.relative_to(ROOT)))]
+    assert found == [], "\n".join(found)
+    wide = "def f(a, b, c, d, e, f, g, h):\n    return a\n"
+    long = "def g(self):\n" + "    x = 1\n" * 45
+    assert long_or_wide(wide, "x.py") == ["x.py:1 f: 2 lines, 8 parameters"]
+    assert long_or_wide(long, "x.py") == ["x.py:1 g: 46 lines, 0 parameters"]

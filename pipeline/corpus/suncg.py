@@ -78,8 +78,7 @@ class _House(NamedTuple):
 
 
 def _room(out: dict, house: _House, room: dict, nodes: list, floor: Path, rtype: str) -> None:
-    """One room of a house level into ``out``'s tables: its floor mesh ``floor`` as outline and walls, the level's
-    ``nodes`` it indexes as objects of room type ``rtype``."""
+    """One room of a house level into ``out``'s tables: floor mesh ``floor`` as outline, the ``nodes`` it indexes."""
     import trimesh
 
     house_id, scale, categories, report = house
