@@ -9,7 +9,8 @@ import numpy as np
 import pandas as pd
 
 from pipeline.geometry.boxes import SIDES
-from pipeline.geometry.function import sides
+from pipeline.geometry.frames import turn_error
+from pipeline.geometry.function import facing_angles, facing_turn, sides
 from pipeline.methods.interface import Scene
 from pipeline.methods.scenes import Rows, drops, plan_loss
 from pipeline.placement import scene_metrics
@@ -37,6 +38,20 @@ def test_sides_of_a_tucked_chair_a_flanking_nightstand_and_a_corner():
     assert {SIDES[s[bed, ns]], SIDES[s[bed, ns + 1]]} == {"left", "right"}
     corner = np.array([room.boxes[desk], [3.0, 1.0, 0.0, 0.1, 0.1, 0.1, 0.0]])  # beyond the desk's right-front corner
     assert s[bed, bed] == -1 and sides(corner)[0, 1] == -1
+
+
+def test_an_object_drawn_off_an_anchors_corner_faces_the_side_it_lies_farthest_beyond():
+    # a sofa 2 m x 0.9 m facing +x (yaw 270 degrees); a coffee table drawn 1.0 m before it and 1.04 m off its centre
+    # line lies beyond its front (2.2 half depths) more than beyond its side (1.04 half widths): it faces the sofa's
+    # front (yaw 90), where the direction to the sofa's centre (44 degrees) is as near the side's turn as the front's
+    sofa = np.array([0.55, 3.71, 0.4, 1.0, 0.45, 0.4, 1.5 * np.pi])
+    corner = np.vstack([sofa, [1.55, 2.67, 0.2, 0.5, 0.3, 0.2, 0.0]])
+    assert sides(corner)[0, 1] == -1 and SIDES[sides(corner, corners=False)[0, 1]] == "front"
+    assert abs(turn_error(facing_turn(sofa, np.array([1.55, 2.67])) - np.pi / 2)) < 1e-9
+    for side, xy, yaw in (("back", (-0.5, 3.7), 1.5 * np.pi), ("left", (0.5, 5.0), np.pi), ("right", (0.6, 2.0), 0.0)):
+        turned = np.vstack([sofa, [*xy, 0.2, 0.5, 0.3, 0.2, facing_turn(sofa, np.array(xy))]])
+        assert SIDES[sides(turned)[0, 1]] == side and abs(turn_error(turned[1, 6] - yaw)) < 1e-9
+        assert facing_angles(turned)[0, 1] < 1e-6  # squarely at the sofa's footprint
 
 
 def test_lost_plan_edges_are_classified_by_when_and_what_extraction_found():

@@ -516,6 +516,11 @@ def test_objects_face_the_placed_objects_the_training_rooms_objects_face_where_t
     assert sum(faces(drawn, seed) for seed in SEEDS) < len(SEEDS) - 2
     partnered = FacingPartner(drawn, {("desk", "chair"): 1.0}, math.pi / 4, 16)
     assert all(faces(partnered, seed) for seed in SEEDS)
+    # a proposer that only ever turns the chair sideways to its wall never faces the desk; with the rule the chair is
+    # turned to squarely face the desk's side its place lies beyond, where that faces
+    sideways = Combined(RelationPrior(cfg["extract"]), Sideways())
+    assert not any(faces(sideways, seed) for seed in SEEDS)
+    assert all(faces(FacingPartner(sideways, {("desk", "chair"): 1.0}, math.pi / 4, 16), seed) for seed in SEEDS)
     alone = lambda proposer, seed: placed(instantiate(plan, room, [0], proposer, Kit(pool, checker),
                                                       cfg["instantiate"], seed), "c")
     assert all(np.array_equal(alone(drawn, seed), alone(partnered, seed)) for seed in SEEDS)

@@ -62,16 +62,30 @@ def equivalent_regions(boxes: np.ndarray, symmetry: ArrayLike | None = None) -> 
     return np.stack(out)
 
 
-def sides(boxes: np.ndarray) -> np.ndarray:
+def sides(boxes: np.ndarray, corners: bool = True) -> np.ndarray:
     """``(n, n)`` index into :data:`~pipeline.geometry.boxes.SIDES` (front, back, left, right) of the anchor side
     target ``j``'s centre lies beyond (over the anchor's footprint, e.g. a chair tucked under a desk: the side it is
-    nearest in the anchor's scaled frame), -1 in a corner region and on the diagonal (row: anchor)."""
+    nearest in the anchor's scaled frame), -1 in a corner region (``corners=False``: the side it lies farthest beyond
+    in the scaled frame) and on the diagonal (row: anchor)."""
     u, v = _normalised(boxes)
     wide, long = np.abs(u) > 1.0, np.abs(v) > 1.0
-    long = np.where(wide | long, long, np.abs(v) >= np.abs(u))
-    out = np.where(wide & long, -1, np.where(long, np.where(v > 0, 0, 1), np.where(u < 0, 2, 3)))
+    corner = wide & long
+    long = np.where(wide ^ long, long, np.abs(v) >= np.abs(u))
+    out = np.where(long, np.where(v > 0, 0, 1), np.where(u < 0, 2, 3))
+    out = np.where(corner, -1, out) if corners else out
     np.fill_diagonal(out, -1)
     return out.astype(np.int8)
+
+
+SIDE_FACING_TURNS = np.array([np.pi, 0.0, -np.pi / 2, np.pi / 2])  # per SIDES: the turn, relative to the anchor's, facing it
+
+
+def facing_turn(anchor: np.ndarray, xy: np.ndarray) -> float:
+    """The yaw (rad) of an object centred at ``xy (2,)`` that squarely faces the side of ``anchor (7,)`` (a box) it
+    stands beyond (:func:`sides` without corners): a coffee table drawn diagonally off a sofa's front corner faces the
+    sofa's front, not whichever of its sides the diagonal happens to be nearer."""
+    boxes = np.vstack([np.asarray(anchor, float).reshape(7), [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, 0.0]])
+    return float(boxes[0, 6] + SIDE_FACING_TURNS[sides(boxes, corners=False)[0, 1]])
 
 
 def _corner_edge_gaps(ca: np.ndarray, cb: np.ndarray) -> np.ndarray:

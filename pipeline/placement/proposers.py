@@ -13,12 +13,14 @@ import numpy as np
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d
 from ..geometry.frames import to_local, to_world, turn_error
-from ..geometry.function import facing_angles, facing_each_other
+from ..geometry.function import facing_angles, facing_each_other, facing_turn
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .layout import box_frame, wall_frame
 from .support import CentreLine, half_depth_on
+
+WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
 
 
 @dataclass
@@ -199,8 +201,9 @@ class FaceAnchor:
     """A proposer whose floor objects planned beside a placed floor anchor face it as often as the training rooms'
     objects of their category face one of the anchor's category standing near it (``shares``: (anchor category,
     object category) -> share, :func:`~pipeline.placement.facing.learn_anchor_facing`): with the largest share among
-    the planned anchors, the drawn turn becomes the one of that anchor's four axis turns that points most directly at
-    its centre from the drawn place (an office chair in front of its desk turns to the desk); the place stays drawn."""
+    the planned anchors, the drawn turn becomes the one that squarely faces the side of that anchor the drawn place
+    lies beyond (:func:`~pipeline.geometry.function.facing_turn`: an office chair in front of its desk turns to the
+    desk); the place stays drawn."""
 
     def __init__(self, base, shares: dict[tuple[str, str], float]):
         self.base, self.shares = base, shares
@@ -212,11 +215,7 @@ class FaceAnchor:
         if drawn is None or not ruled or any(a.kind == SUPPORT for a in req.anchors) or rng.random() >= max(ruled)[0]:
             return drawn
         xy, _ = drawn
-        anchor = req.room.boxes.reshape(-1, 7)[max(ruled)[1]]
-        to = anchor[:2] - xy
-        heading = float(np.arctan2(-to[0], to[1]))  # the yaw whose front (-sin, cos) points at the anchor's centre
-        turns = anchor[6] + np.arange(4) * np.pi / 2
-        return xy, float(turns[np.argmin(turn_error(turns - heading))])
+        return xy, facing_turn(req.room.boxes.reshape(-1, 7)[max(ruled)[1]], xy)
 
 
 class FacingPartner:
@@ -224,11 +223,13 @@ class FacingPartner:
     objects of their category face one of that category (``shares``: (partner category, object category) -> share,
     :func:`~pipeline.placement.facing.learn_facing_partners`): with the largest such share among the placed
     partners, the pose is drawn from the base proposer conditioned on facing one of them within ``facing`` rad
-    (:func:`~pipeline.geometry.function.facing_each_other`), by drawing up to ``tries`` poses and keeping the first that
-    does (else the first drawn). With no partner placed yet, a partner the plan puts against a wall later
-    (:attr:`Request.ahead`: a sofa placed before its television stand) stands in as that wall: the object is drawn
-    facing the wall's segment. A partner the object has a planned edge to is the plan's; an object on a support has
-    none."""
+    (:func:`~pipeline.geometry.function.facing_each_other`): up to ``tries`` poses are drawn and the first that faces
+    one is kept; where none does, the first that does once turned to squarely face the side of the nearest partner its
+    place lies beyond (:func:`~pipeline.geometry.function.facing_turn`; a turn drawn, as a wall back, goes first),
+    else the first drawn. With no partner placed yet, a
+    partner the plan puts against a wall later (:attr:`Request.ahead`: a sofa placed before its television stand)
+    stands in as that wall: the object is drawn facing the wall's segment. A partner the object has a planned edge to
+    is the plan's; an object on a support has none."""
 
     def __init__(self, base, shares: dict[tuple[str, str], float], facing: float, tries: int):
         self.base, self.shares, self.facing, self.tries = base, shares, facing, tries
@@ -237,24 +238,29 @@ class FacingPartner:
         first = self.base.pose(req, rng)
         if first is None or any(a.kind == SUPPORT for a in req.anchors):
             return first
-        partners, share, faces = self._partners(req), 0.0, self._faces
+        partners, share, boxes, wall = self._partners(req), 0.0, req.room.boxes.reshape(-1, 7), False
         if len(partners):
             share = max(self.shares[(req.room.categories[o], req.category)] for o in partners)
+            boxes = boxes[partners]
         else:
             later = [(self.shares[(c, req.category)], w) for c, w in req.ahead if (c, req.category) in self.shares]
             if later:
-                share, wall = max(later)
-                partners, faces = np.array([wall]), self._faces_wall
+                share, w = max(later)
+                boxes, wall = self._wall_box(req, w), True
         if not share or rng.random() >= share:
             return first
-        drawn: tuple[np.ndarray, float] | None = first
-        for _ in range(self.tries):
+        turned: tuple[np.ndarray, float] | None = None
+        for k in range(self.tries):
+            drawn = first if k == 0 else self.base.pose(req, rng)
             if drawn is None:
                 break
-            if faces(req, partners, *drawn):
+            xy, yaw = drawn
+            if self._faces(boxes, xy, yaw, wall):
                 return drawn
-            drawn = self.base.pose(req, rng)
-        return first
+            turn = facing_turn(boxes[np.argmin(np.linalg.norm(boxes[:, :2] - xy, axis=1))], xy)
+            if turned is None and self._faces(boxes, xy, turn, wall):
+                turned = (xy, turn)
+        return turned or first
 
     def _partners(self, req: Request) -> np.ndarray:
         """Indices of the placed objects of a partner category the plan gives the object no edge to."""
@@ -262,17 +268,19 @@ class FacingPartner:
         cats = req.room.categories
         return np.array([k for k, c in enumerate(cats) if (c, req.category) in self.shares and c not in planned], int)
 
-    def _faces(self, req: Request, partners: np.ndarray, xy: np.ndarray, yaw: float) -> bool:
-        boxes = np.vstack([req.room.boxes.reshape(-1, 7)[partners], [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
+    def _faces(self, partners: np.ndarray, xy: np.ndarray, yaw: float, wall: bool) -> bool:
+        """A pose at ``xy`` turned ``yaw`` faces one of ``partners (m, 7)``: each within ``facing`` of the other (a
+        ``wall``'s box, :meth:`_wall_box`: only the pose's front counts)."""
+        boxes = np.vstack([partners, [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
+        if wall:
+            return bool(facing_angles(boxes)[:-1, -1].min() <= self.facing)
         return bool(facing_each_other(boxes, self.facing)[:-1, -1].any())
 
-    def _faces_wall(self, req: Request, walls: np.ndarray, xy: np.ndarray, yaw: float) -> bool:
-        """The pose's front lies within ``facing`` of the direction to the nearest point of wall ``walls[0]``."""
-        w = int(walls[0])
+    @staticmethod
+    def _wall_box(req: Request, w: int) -> np.ndarray:
+        """``(1, 7)``: wall ``w``'s segment as a box of depth :data:`WALL_DEPTH` whose front faces into the room."""
         mid, half = (req.walls.a[w] + req.walls.b[w]) / 2, req.walls.length[w] / 2
-        boxes = np.array([[mid[0], mid[1], 0.0, half, 1e-3, 0.0, wall_frame(req.walls, w).yaw],
-                          [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
-        return bool(facing_angles(boxes)[0, 1] <= self.facing)
+        return np.array([[mid[0], mid[1], 0.0, half, WALL_DEPTH, 0.0, wall_frame(req.walls, w).yaw]])
 
 
 class Combined(DensityProposer):
