@@ -225,8 +225,8 @@ class FacingPartner:
     partners, the pose is drawn from the base proposer conditioned on facing one of them within ``facing`` rad
     (:func:`~pipeline.geometry.function.facing_each_other`): up to ``tries`` poses are drawn and the first that faces
     one is kept; where none does, the first that does once turned to squarely face the side of the nearest partner its
-    place lies beyond (:func:`~pipeline.geometry.function.facing_turn`; a turn drawn, as a wall back, goes first),
-    else the first drawn. With no partner placed yet, a
+    place lies beyond (:func:`~pipeline.geometry.function.facing_turn`; a turn drawn, as a wall back, goes first; never
+    turned away from a planned anchor it faced as drawn), else the first drawn. With no partner placed yet, a
     partner the plan puts against a wall later (:attr:`Request.ahead`: a sofa placed before its television stand)
     stands in as that wall: the object is drawn facing the wall's segment. A partner the object has a planned edge to
     is the plan's; an object on a support has none."""
@@ -258,7 +258,7 @@ class FacingPartner:
             if self._faces(boxes, xy, yaw, wall):
                 return drawn
             turn = facing_turn(boxes[np.argmin(np.linalg.norm(boxes[:, :2] - xy, axis=1))], xy)
-            if turned is None and self._faces(boxes, xy, turn, wall):
+            if turned is None and self._faces(boxes, xy, turn, wall) and self._keeps(req, xy, yaw, turn):
                 turned = (xy, turn)
         return turned or first
 
@@ -267,6 +267,17 @@ class FacingPartner:
         planned = {req.room.categories[a.obj] for a in req.anchors if a.obj is not None}
         cats = req.room.categories
         return np.array([k for k, c in enumerate(cats) if (c, req.category) in self.shares and c not in planned], int)
+
+    def _keeps(self, req: Request, xy: np.ndarray, yaw: float, turn: float) -> bool:
+        """Turned from ``yaw`` to ``turn`` at ``xy``, the object still faces (within ``facing``) every planned object
+        anchor it faced as drawn: an office chair turned to its desk by its plan is never turned to another desk."""
+        planned = [a.obj for a in req.anchors if a.obj is not None and not a.reverse]
+        if not planned:
+            return True
+        boxes = np.vstack([req.room.boxes.reshape(-1, 7)[planned], [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw],
+                           [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, turn]])
+        angles = facing_angles(boxes)[:-2, -2:]  # (planned, drawn | turned)
+        return bool(np.all((angles[:, 0] > self.facing) | (angles[:, 1] <= self.facing)))
 
     def _faces(self, partners: np.ndarray, xy: np.ndarray, yaw: float, wall: bool) -> bool:
         """A pose at ``xy`` turned ``yaw`` faces one of ``partners (m, 7)``: each within ``facing`` of the other (a
