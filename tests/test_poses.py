@@ -485,6 +485,13 @@ def test_objects_planned_beside_an_anchor_face_it_as_often_as_in_the_training_ro
     assert all(angle(turned, seed) < math.pi / 4 for seed in SEEDS)
     assert all(turn_error(chair(turned, seed)[6] - math.pi) < 1e-9 for seed in SEEDS)  # square to the desk
     assert all(np.array_equal(chair(drawn, seed), chair(FaceAnchor(drawn, {}), seed)) for seed in SEEDS)
+    # a partner rule never turns it away from the desk it faces by its plan: a nightstand up the room's left side,
+    # turned to face the chair's place, is a partner the chair can be turned to face, and is not
+    with_stand = given(desk, pool, "nightstand", "ns", (0.4, 2.5), -90)
+    partnered = FacingPartner(turned, {("nightstand", "chair"): 1.0}, math.pi / 4, 16)
+    to_desk = lambda seed: facing_angles(np.vstack([desk.boxes.reshape(-1, 7), placed(instantiate(
+        plan, with_stand, [0], partnered, Kit(pool, checker), cfg["instantiate"], seed), "c")]))[0, 1]
+    assert all(to_desk(seed) < math.pi / 4 for seed in SEEDS)
 
 
 def test_objects_face_the_placed_objects_the_training_rooms_objects_face_where_the_plan_says_nothing():
