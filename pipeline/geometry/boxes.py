@@ -38,6 +38,13 @@ def on_floor(boxes: np.ndarray, floor_contact: float) -> np.ndarray:
     return cast(np.ndarray, b[:, 2] - b[:, 5] <= floor_contact)
 
 
+def point_box(xy: ArrayLike, yaw: float = 0.0) -> np.ndarray:
+    """``(7,)`` a candidate centre ``xy (2,)`` turned ``yaw`` as a box of zero extents on the floor (what the plan
+    predicates read of a pose before an object's extents matter)."""
+    x, y = np.asarray(xy, float).reshape(2)
+    return np.array([x, y, 0.0, 0.0, 0.0, 0.0, yaw], float)
+
+
 def diagonal_2d(hx: ArrayLike, hy: ArrayLike) -> np.ndarray:
     """Footprint diagonal length."""
     return cast(np.ndarray, 2.0 * np.hypot(hx, hy))

@@ -15,7 +15,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .boxes import footprint_corners, footprint_overlap, rotation
+from .boxes import footprint_corners, footprint_overlap, point_box, rotation
 from .frames import FOLD, RADIAL_FRAMES, turn_error, wrap
 from .polygon import inward_normals, make_ccw, polygon_segments
 
@@ -84,7 +84,7 @@ def facing_turn(anchor: np.ndarray, xy: np.ndarray) -> float:
     """The yaw (rad) of an object centred at ``xy (2,)`` that squarely faces the side of ``anchor (7,)`` (a box) it
     stands beyond (:func:`sides` without corners): a coffee table drawn diagonally off a sofa's front corner faces the
     sofa's front, not whichever of its sides the diagonal happens to be nearer."""
-    boxes = np.vstack([np.asarray(anchor, float).reshape(7), [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, 0.0]])
+    boxes = np.vstack([np.asarray(anchor, float).reshape(7), point_box(xy)])
     return float(boxes[0, 6] + SIDE_FACING_TURNS[sides(boxes, corners=False)[0, 1]])
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..geometry import raster
-from ..geometry.boxes import SIDES, diagonal_2d
+from ..geometry.boxes import SIDES, diagonal_2d, point_box
 from ..geometry.frames import to_local, to_world, turn_error
 from ..geometry.function import facing_angles, facing_each_other, facing_turn
 from ..geometry.polygon import nearest_segment
@@ -274,15 +274,14 @@ class FacingPartner:
         planned = [a.obj for a in req.anchors if a.obj is not None and not a.reverse]
         if not planned:
             return True
-        boxes = np.vstack([req.room.boxes.reshape(-1, 7)[planned], [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw],
-                           [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, turn]])
+        boxes = np.vstack([req.room.boxes.reshape(-1, 7)[planned], point_box(xy, yaw), point_box(xy, turn)])
         angles = facing_angles(boxes)[:-2, -2:]  # (planned, drawn | turned)
         return bool(np.all((angles[:, 0] > self.facing) | (angles[:, 1] <= self.facing)))
 
     def _faces(self, partners: np.ndarray, xy: np.ndarray, yaw: float, wall: bool) -> bool:
         """A pose at ``xy`` turned ``yaw`` faces one of ``partners (m, 7)``: each within ``facing`` of the other (a
         ``wall``'s box, :meth:`_wall_box`: only the pose's front counts)."""
-        boxes = np.vstack([partners, [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
+        boxes = np.vstack([partners, point_box(xy, yaw)])
         if wall:
             return bool(facing_angles(boxes)[:-1, -1].min() <= self.facing)
         return bool(facing_each_other(boxes, self.facing)[:-1, -1].any())
@@ -370,7 +369,7 @@ class Centred:
         ruled = np.array([(c, req.category, "facing") in self.rules for c in req.room.categories], bool)
         if not ruled.any():
             return np.zeros(0, int)
-        boxes = np.vstack([req.room.boxes.reshape(-1, 7), [xy[0], xy[1], 0.0, 0.0, 0.0, 0.0, yaw]])
+        boxes = np.vstack([req.room.boxes.reshape(-1, 7), point_box(xy, yaw)])
         return np.flatnonzero(ruled & facing_each_other(boxes, self.facing)[:-1, -1])
 
     @staticmethod
