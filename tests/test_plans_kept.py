@@ -58,7 +58,7 @@ def test_real_3d_front_objects_facing_a_near_anchor_mostly_take_the_turn_facing_
     # on the 3D-FRONT sample's rooms, of the floor objects within 0.5 m of a floor anchor and facing it (within 45
     # degrees), 89 of 114 stand within 15 degrees of facing_turn (the rest stand turned off their anchor's axes, which
     # no square turn gives); the anchor's axis turn nearest the direction to its centre, the rule it replaced, gives 89
-    # too; turned a quarter, facing_turn would give none of them
+    # too; a quarter turn from facing_turn matches 2 of them
     from pipeline.geometry.boxes import on_floor
     from pipeline.geometry.function import plan_gaps
     from pipeline.room import room_inputs
