@@ -398,8 +398,12 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
     assert min(back_gap(r.boxes.reshape(-1, 7)[r.object_ids.index("stand")],
                         r.boxes.reshape(-1, 7)[r.object_ids.index("tv")]) for r in centred) > flush
     assert ("tv_stand", "tv", "back") not in learn(centred)
-    rules = learn([_tv_at_back(furnished(s), 0.01).room_input() for s in range(12)])
-    assert rules[("tv_stand", "tv", "back")] == (1.0, 0.01)
+    at_back = [_tv_at_back(furnished(s), 0.01).room_input() for s in range(12)]
+    rules = learn(at_back)
+    reach = max(abs(to_local(box_frame(r.boxes.reshape(-1, 7)[r.object_ids.index("stand")]),
+                             r.boxes.reshape(-1, 7)[r.object_ids.index("tv"), :2])[1]) for r in at_back)
+    assert rules[("tv_stand", "tv", "back")][:2] == (1.0, 0.01)
+    assert reach <= rules[("tv_stand", "tv", "back")][2] < reach + 0.001
     assert ("tv_stand", "tv", "back") not in learn([_tv_at_back(furnished(s), 0.05).room_input() for s in range(12)])
     assert ("tv_stand", "tv", "back") not in learn([_tv_at_back(furnished(s), 0.01).room_input() for s in range(9)])
     # applied: uniform places on the stand's top stand anywhere along it; with the rule, at its gap from the back edge,
@@ -411,10 +415,14 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
     tv = lambda proposer, seed: placed(instantiate(plan, base, [0], proposer, Kit(pool, checker), cfg["instantiate"],
                                                    seed), "t")
     assert max(abs(back_gap(base.boxes[0], tv(uniform, seed)) - 0.01) for seed in SEEDS) > 0.02
-    at_back = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01)})
+    at_back = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01, 1.0)})
     placed_tvs = [tv(at_back, seed) for seed in SEEDS]
     assert max(abs(back_gap(base.boxes[0], t) - 0.01) for t in placed_tvs) < 1e-9
     assert np.ptp([to_local(box_frame(base.boxes[0]), t[:2])[0] for t in placed_tvs]) > 0.01
+    # refused where the back edge lies farther off the stand's centre line than any training TV stood: the TVs stand
+    # where the uniform draw put them, none at the back
+    beyond = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01, 0.001)})
+    assert min(abs(back_gap(base.boxes[0], tv(beyond, seed)) - 0.01) for seed in SEEDS) > 1e-3
 
 
 def test_two_objects_facing_each_other_stand_on_one_axis_as_in_the_training_rooms_planned_edge_or_not():

@@ -325,12 +325,14 @@ class Centred:
     rooms' do: ``rules`` maps (anchor category, object category, ``support`` | ``spatial`` | ``facing``) to the
     :class:`~pipeline.placement.support.CentreLine` of :func:`~pipeline.placement.support.learn_centring` (a plain
     ``(across, along)`` pair of shares: offsets 0). On a support, with the ``back`` rule's share the drawn place
-    moves along the support to stand the rule's gap from its back edge (a monitor at the back of its desk), else
-    with each share's probability the drawn place's offset across (along) the support is replaced by one of the
-    training pairs' offsets near the line, drawn uniformly; beside a placed
-    floor anchor planned in front of or behind it, the offset across it, and planned left or right of it, the offset
-    along it; a floor object facing a placed object with no planned edge to it, the two facing each other within
-    ``facing`` rad at the drawn pose (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it.
+    moves along the support to stand the rule's gap from its back edge (a monitor at the back of its desk) unless that
+    puts its centre farther off the support's centre line than any training pair's (a thin television at the back of a
+    deep stand, the stand's middle no longer under it), else with each share's probability the drawn place's offset
+    across (along) the support is replaced by one of the training pairs' offsets near the line, drawn uniformly;
+    beside a placed floor anchor planned in front of or behind it, the offset across it, and planned left or right of
+    it, the offset along it; a floor object facing a placed object with no planned edge to it, the two facing each
+    other within ``facing`` rad at the drawn pose (:func:`~pipeline.geometry.function.facing_each_other`), the offset
+    across it.
     A drawn place is only as fine as the proposer's grid or network (0.15 m per pixel for PlanIT's at the default
     preset); the turn is the base proposer's.
     """
@@ -354,7 +356,9 @@ class Centred:
             share = np.asarray(line[:2]) * (
                 [1, 1] if a.kind == SUPPORT else [1, 0] if a.direction in ("front", "back") else [0, 1])
             if back is not None and rng.random() < back[0]:
-                xy, share = self._onto_back(req.room.boxes[a.obj], a.target_half, yaw, back[1], xy), share * [1, 0]
+                moved = self._onto_back(req.room.boxes[a.obj], a.target_half, yaw, back[1], xy)
+                if abs(to_local(box_frame(req.room.boxes[a.obj]), moved)[1]) <= back[2]:
+                    xy, share = moved, share * [1, 0]
             xy = self._onto_line(a.frame, xy, share, line, rng)
         planned = {a.obj for a in req.anchors}
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):

@@ -140,9 +140,10 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
     stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
     front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
     ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
-    room), across. ``back``: ``(share, gap)``, the share of an object's pairs with its support whose footprint stands
-    within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk) and their median
-    gap (m). A share needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within
+    room), across. ``back``: ``(share, gap, reach)``, the share of an object's pairs with its support whose footprint
+    stands within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk), their
+    median gap (m) and the farthest any pair's centre stood off the support's centre line along its depth (m: a
+    television flush with the back of a deep stand stands farther off it than any training television did). A share needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within
     10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
     seen, backs = centre_offsets(rooms, tolerance, floor_contact, facing)
     rules: dict[Key, tuple] = {}
@@ -154,7 +155,9 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
     for key, gaps in sorted(backs.items()):
         flush_share = share([abs(g) <= flush for g in gaps])
         if flush_share:
-            rules[key] = (round(flush_share, 3), round(float(np.median([g for g in gaps if abs(g) <= flush])), 3))
+            reach = float(np.abs(seen[(key[0], key[1], "support")][1][:, 0]).max())
+            rules[key] = (round(flush_share, 3), round(float(np.median([g for g in gaps if abs(g) <= flush])), 3),
+                          float(np.ceil(reach * 1000) / 1000))
     return rules
 
 
