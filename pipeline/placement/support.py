@@ -143,8 +143,9 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
     room), across. ``back``: ``(share, gap, reach)``, the share of an object's pairs with its support whose footprint
     stands within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk), their
     median gap (m) and the farthest any pair's centre stood off the support's centre line along its depth (m: a
-    television flush with the back of a deep stand stands farther off it than any training television did). A share needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within
-    10 cm of a narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
+    television flush with the back of a deep stand stands farther off it than any training television did). A share
+    needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within 10 cm of a
+    narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
     seen, backs = centre_offsets(rooms, tolerance, floor_contact, facing)
     rules: dict[Key, tuple] = {}
     for key, axes in sorted(seen.items()):
