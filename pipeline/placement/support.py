@@ -171,7 +171,7 @@ def _back_rule(key: Key, gaps: np.ndarray, lines: tuple[np.ndarray, np.ndarray],
     reach = float(np.ceil(np.abs(lines[1][:, 0]).max() * 1000) / 1000)
     out: dict[Key, tuple] = {key: (round(float(flat.mean()), 3), round(float(np.median(gaps[flat])), 3), reach)}
     support = (key[0], key[1], "support")
-    line = rules.get(support, CentreLine(0.0, 0.0))
+    line = CentreLine(*rules.get(support, (0.0, 0.0)))
     along, offsets = _near_line(lines[1][~flat], window)
     if along:
         out[support] = CentreLine(line.across, along, line.across_offsets, offsets)
