@@ -22,7 +22,7 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import BackToWall, Centred, Combined, FaceAnchor, FaceAway, FacingPartner, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import Kit, instantiate
-from pipeline.placement.support import CentreLine, Window, back_gap, learn_centring
+from pipeline.placement.support import EDGES, CentreLine, Window, edge_gap, learn_centring
 from pipeline.placement.walls import learn_wall_backs
 
 from conftest import Room, default_config
@@ -360,42 +360,43 @@ def test_objects_planned_against_a_wall_turn_their_back_to_it_as_often_as_in_the
         assert back_to_wall(d[None], room.outline, 0.1, math.radians(15))[0], (seed, d)
 
 
-def test_back_gap_reads_flush_overhanging_and_turned_footprints_and_onto_back_inverts_it():
+def test_edge_gap_reads_flush_overhanging_and_turned_footprints_and_onto_back_inverts_it():
     desk = np.array([1.0, 2.0, 0.4, 0.6, 0.3, 0.4, 0.0])  # depth along y: back edge at y = 1.7
     box = lambda x, y, yaw, hx=0.2, hy=0.1: np.array([x, y, 0.9, hx, hy, 0.1, yaw])
-    assert back_gap(desk, box(1.3, 1.8, 0.0)) == pytest.approx(0.0)  # flush: its back face on the edge
-    assert back_gap(desk, box(0.8, 1.85, math.pi)) == pytest.approx(0.05)  # turned round: same depth
-    assert back_gap(desk, box(1.0, 1.9, math.pi / 2)) == pytest.approx(0.0)  # a quarter turn: its width is the depth
-    assert back_gap(desk, box(1.0, 1.75, 0.0)) == pytest.approx(-0.05)  # overhangs the back
+    assert edge_gap(desk, box(1.3, 1.8, 0.0)) == pytest.approx(0.0)  # flush: its back face on the edge
+    assert edge_gap(desk, box(0.8, 1.85, math.pi)) == pytest.approx(0.05)  # turned round: same depth
+    assert edge_gap(desk, box(1.0, 1.9, math.pi / 2)) == pytest.approx(0.0)  # a quarter turn: its width is the depth
+    assert edge_gap(desk, box(1.0, 1.75, 0.0)) == pytest.approx(-0.05)  # overhangs the back
     turned = desk.copy()
     turned[6] = math.pi / 2  # the back edge now at x = 1.3 (local -y points to +x)
-    assert back_gap(turned, box(1.2, 2.0, math.pi / 2)) == pytest.approx(0.0)
-    assert back_gap(turned, box(1.2, 2.0, 0.0)) == pytest.approx(-0.1)  # its 0.2 m half width overhangs by 0.1
+    assert edge_gap(turned, box(1.2, 2.0, math.pi / 2)) == pytest.approx(0.0)
+    assert edge_gap(turned, box(1.2, 2.0, 0.0)) == pytest.approx(-0.1)  # its 0.2 m half width overhangs by 0.1
     rng = np.random.default_rng(0)
     for support in (desk, turned):
         for _ in range(20):
             yaw, xy = rng.uniform(-math.pi, math.pi), support[:2] + rng.uniform(-0.3, 0.3, 2)
-            moved = Centred._onto_back(support, (0.2, 0.1), yaw, 0.016, xy)
-            assert back_gap(support, box(*moved, yaw)) == pytest.approx(0.016)
+            moved = Centred._onto_edge(support, (0.2, 0.1), yaw, ("back", (1.0, 0.016, 1.0)), xy)
+            assert edge_gap(support, box(*moved, yaw)) == pytest.approx(0.016)
             assert to_local(box_frame(support), moved)[0] == pytest.approx(to_local(box_frame(support), xy)[0])
 
 
-def _tv_at_back(room: Room, gap: float) -> Room:
-    """``room`` with its TV moved along its stand to stand ``gap`` m from the stand's back edge."""
+def _tv_at_back(room: Room, gap: float, edge: str = "back") -> Room:
+    """``room`` with its TV moved along its stand to stand ``gap`` m from the stand's back (front) edge."""
     inp = room.room_input()
     b = inp.boxes.reshape(-1, 7)
     stand, tv = b[inp.object_ids.index("stand")], b[inp.object_ids.index("tv")]
-    return _shifted(room, "tv", (back_gap(stand, tv) - gap) * np.array([math.sin(stand[6]), -math.cos(stand[6])]))
+    toward = EDGES[edge] * np.array([-math.sin(stand[6]), math.cos(stand[6])])  # the stand's local +y in the room
+    return _shifted(room, "tv", (edge_gap(stand, tv, edge) - gap) * toward)
 
 
 def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_rooms():
-    # learned: televisions 1 cm from their stands' back edges give a back rule at that gap; centred ones (15 cm
-    # off it) or 5 cm off it (beyond flush_within, 3 cm) give none; too few pairs give none
+    # learned: televisions 1 cm (5 cm) from their stands' back edges give a back rule at that gap; centred ones (15 cm
+    # off it: their share on the stand's middle is as high) give none; too few pairs give none
     cfg = default_config()
     flush = cfg["instantiate"]["snap"]["flush_within"]
     learn = lambda rooms, least=10: learn_centring(rooms, Window(0.02, least), 0.02, cfg["floor_contact"], math.pi / 4, flush)
     centred = [furnished(s).room_input() for s in range(12)]
-    assert min(back_gap(r.boxes.reshape(-1, 7)[r.object_ids.index("stand")],
+    assert min(edge_gap(r.boxes.reshape(-1, 7)[r.object_ids.index("stand")],
                         r.boxes.reshape(-1, 7)[r.object_ids.index("tv")]) for r in centred) > flush
     assert ("tv_stand", "tv", "back") not in learn(centred)
     at_back = [_tv_at_back(furnished(s), 0.01).room_input() for s in range(12)]
@@ -404,8 +405,11 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
                              r.boxes.reshape(-1, 7)[r.object_ids.index("tv"), :2])[1]) for r in at_back)
     assert rules[("tv_stand", "tv", "back")][:2] == (1.0, 0.01)
     assert reach <= rules[("tv_stand", "tv", "back")][2] < reach + 0.001
-    assert ("tv_stand", "tv", "back") not in learn([_tv_at_back(furnished(s), 0.05).room_input() for s in range(12)])
+    assert learn([_tv_at_back(furnished(s), 0.05).room_input() for s in range(12)])[("tv_stand", "tv", "back")][:2] == (
+        1.0, 0.05)
     assert ("tv_stand", "tv", "back") not in learn([_tv_at_back(furnished(s), 0.01).room_input() for s in range(9)])
+    at_front = learn([_tv_at_back(furnished(s), 0.02, "front").room_input() for s in range(12)])
+    assert at_front[("tv_stand", "tv", "front")][:2] == (1.0, 0.02) and ("tv_stand", "tv", "back") not in at_front
     # applied: uniform places on the stand's top stand anywhere along it; with the rule, at its gap from the back edge,
     # the offset across the stand still drawn
     room, walls, pool, checker, cfg = setup_room(furnished(0))
@@ -414,26 +418,28 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
     uniform = Combined(UniformLocation(), FaceAway())
     tv = lambda proposer, seed: placed(instantiate(plan, base, [0], proposer, Kit(pool, checker), cfg["instantiate"],
                                                    seed), "t")
-    assert max(abs(back_gap(base.boxes[0], tv(uniform, seed)) - 0.01) for seed in SEEDS) > 0.02
+    assert max(abs(edge_gap(base.boxes[0], tv(uniform, seed)) - 0.01) for seed in SEEDS) > 0.02
     at_back = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01, 1.0)})
     placed_tvs = [tv(at_back, seed) for seed in SEEDS]
-    assert max(abs(back_gap(base.boxes[0], t) - 0.01) for t in placed_tvs) < 1e-9
+    assert max(abs(edge_gap(base.boxes[0], t) - 0.01) for t in placed_tvs) < 1e-9
     assert np.ptp([to_local(box_frame(base.boxes[0]), t[:2])[0] for t in placed_tvs]) > 0.01
     # refused where the back edge lies farther off the stand's centre line than any training TV stood: the TVs stand
     # where the uniform draw put them, none at the back
     beyond = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01, 0.001)})
-    assert min(abs(back_gap(base.boxes[0], tv(beyond, seed)) - 0.01) for seed in SEEDS) > 1e-3
+    assert min(abs(edge_gap(base.boxes[0], tv(beyond, seed)) - 0.01) for seed in SEEDS) > 1e-3
+    at_front = Centred(uniform, {("tv_stand", "tv", "front"): (1.0, 0.02, 1.0)})
+    assert max(abs(edge_gap(base.boxes[0], tv(at_front, seed), "front") - 0.02) for seed in SEEDS) < 1e-9
 
 
 def test_objects_not_at_their_supports_back_edge_stand_where_the_training_rooms_others_stand():
-    # learned: half the televisions 1 cm from their stands' back edges, half on the stand's middle: the share on the
-    # middle is taken over the half not at the back (all of it), not over every pair (a half)
+    # learned: 18 of 30 televisions 1 cm from their stands' back edges, 12 on the stand's middle: the share on the
+    # middle is taken over the 12 not at the back (all of them), not over every pair (0.4)
     cfg = default_config()
     flush = cfg["instantiate"]["snap"]["flush_within"]
-    mixed = [_tv_at_back(furnished(s), 0.01).room_input() for s in range(12)] + [furnished(s).room_input()
-                                                                                for s in range(12, 24)]
+    mixed = [_tv_at_back(furnished(s), 0.01).room_input() for s in range(18)] + [furnished(s).room_input()
+                                                                                for s in range(18, 30)]
     rules = learn_centring(mixed, Window(0.02), 0.02, cfg["floor_contact"], math.pi / 4, flush)
-    assert rules[("tv_stand", "tv", "back")][:2] == (0.5, 0.01)
+    assert rules[("tv_stand", "tv", "back")][:2] == (0.6, 0.01)
     line = rules[("tv_stand", "tv", "support")]
     assert line.along == 1.0 and len(line.along_offsets) == 12 and max(map(abs, line.along_offsets)) < 1e-9
     # applied: every television stands at the back edge or on the middle, both seen
@@ -443,7 +449,7 @@ def test_objects_not_at_their_supports_back_edge_stand_where_the_training_rooms_
     proposer = Centred(Combined(UniformLocation(), FaceAway()), rules)
     tvs = [placed(instantiate(plan, base, [0], proposer, Kit(pool, checker), cfg["instantiate"], seed), "t")
            for seed in SEEDS]
-    at_back = [abs(back_gap(base.boxes[0], t) - 0.01) < 1e-9 for t in tvs]
+    at_back = [abs(edge_gap(base.boxes[0], t) - 0.01) < 1e-9 for t in tvs]
     middle = [abs(to_local(box_frame(base.boxes[0]), t[:2])[1]) < 1e-9 for t in tvs]
     assert all(a or m for a, m in zip(at_back, middle)) and any(at_back) and any(middle)
 

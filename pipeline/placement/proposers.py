@@ -18,7 +18,7 @@ from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .layout import box_frame, wall_frame
-from .support import CentreLine, half_depth_on
+from .support import EDGES, CentreLine, half_depth_on
 
 WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
 
@@ -324,17 +324,17 @@ class Centred:
     """A proposer whose objects stand near their anchors' centre lines as often and as far off them as the training
     rooms' do: ``rules`` maps (anchor category, object category, ``support`` | ``spatial`` | ``facing``) to the
     :class:`~pipeline.placement.support.CentreLine` of :func:`~pipeline.placement.support.learn_centring` (a plain
-    ``(across, along)`` pair of shares: offsets 0). On a support, with the ``back`` rule's share the drawn place
-    moves along the support to stand the rule's gap from its back edge (a monitor at the back of its desk) unless that
-    puts its centre farther off the support's centre line than any training pair's (a thin television at the back of a
-    deep stand, the stand's middle no longer under it), else with each share's probability the drawn place's offset
-    across (along) the support is replaced by one of the training pairs' offsets near the line, drawn uniformly;
-    beside a placed floor anchor planned in front of or behind it, the offset across it, and planned left or right of
-    it, the offset along it; a floor object facing a placed object with no planned edge to it, the two facing each
-    other within ``facing`` rad at the drawn pose (:func:`~pipeline.geometry.function.facing_each_other`), the offset
-    across it.
-    A drawn place is only as fine as the proposer's grid or network (0.15 m per pixel for PlanIT's at the default
-    preset); the turn is the base proposer's.
+    ``(across, along)`` pair of shares: offsets 0). On a support, with the ``back`` or ``front`` rule's share the
+    drawn place moves along the support to stand the rule's gap from that edge (a monitor at the back of its desk, a
+    keyboard at its front) unless that puts its centre farther off the support's centre line than any training
+    pair's (a thin television at the back of a deep stand, the stand's middle no longer under it), else with each
+    share's probability the drawn place's offset across (along) the support is replaced by one of the training
+    pairs' offsets near the line, drawn uniformly; beside a placed floor anchor planned in front of or behind it,
+    the offset across it, and planned left or right of it, the offset along it; a floor object facing a placed
+    object with no planned edge to it, the two facing each other within ``facing`` rad at the drawn pose
+    (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it. A drawn place is only as fine as
+    the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
+    proposer's.
     """
 
     def __init__(self, base, rules: dict[tuple[str, str, str], tuple], facing: float = np.pi / 4):
@@ -349,15 +349,15 @@ class Centred:
             if a.obj is None or a.reverse:
                 continue
             pair = (req.room.categories[a.obj], req.category)
-            rule, back = self.rules.get((*pair, a.kind)), self.rules.get((*pair, "back")) if a.kind == SUPPORT else None
-            if rule is None and back is None:
+            rule, edge = self.rules.get((*pair, a.kind)), self._edge(pair) if a.kind == SUPPORT else None
+            if rule is None and edge is None:
                 continue
             line = CentreLine(*(rule or (0.0, 0.0)))
             share = np.asarray(line[:2]) * (
                 [1, 1] if a.kind == SUPPORT else [1, 0] if a.direction in ("front", "back") else [0, 1])
-            if back is not None and rng.random() < back[0]:
-                moved = self._onto_back(req.room.boxes[a.obj], a.target_half, yaw, back[1], xy)
-                if abs(to_local(box_frame(req.room.boxes[a.obj]), moved)[1]) <= back[2]:
+            if edge is not None and rng.random() < edge[1][0]:
+                moved = self._onto_edge(req.room.boxes[a.obj], a.target_half, yaw, edge, xy)
+                if abs(to_local(box_frame(req.room.boxes[a.obj]), moved)[1]) <= edge[1][2]:
                     xy, share = moved, share * [1, 0]
             xy = self._onto_line(a.frame, xy, share, line, rng)
         planned = {a.obj for a in req.anchors}
@@ -376,13 +376,17 @@ class Centred:
         boxes = np.vstack([req.room.boxes.reshape(-1, 7), point_box(xy, yaw)])
         return np.flatnonzero(ruled & facing_each_other(boxes, self.facing)[:-1, -1])
 
+    def _edge(self, pair: tuple[str, str]) -> tuple[str, tuple] | None:
+        """The (support, object) ``pair``'s edge rule, ``(edge, (share, gap, reach))`` (None: none learned)."""
+        return next(((e, self.rules[(*pair, e)]) for e in EDGES if (*pair, e) in self.rules), None)
+
     @staticmethod
-    def _onto_back(support: np.ndarray, half, yaw: float, gap: float, xy: np.ndarray) -> np.ndarray:
+    def _onto_edge(support: np.ndarray, half, yaw: float, edge: tuple[str, tuple], xy: np.ndarray) -> np.ndarray:
         """``xy`` moved along ``support (7,)`` so that a footprint of half extents ``half (2,)`` turned ``yaw`` stands
-        ``gap`` m from the support's back edge (:func:`~pipeline.placement.support.back_gap`)."""
+        the ``edge`` rule's gap from that edge (:func:`~pipeline.placement.support.edge_gap`)."""
         frame = box_frame(support)
         local = to_local(frame, xy)
-        local[1] = gap - support[4] + half_depth_on(support, half, yaw)
+        local[1] = EDGES[edge[0]] * (support[4] - half_depth_on(support, half, yaw) - edge[1][1])
         return to_world(frame, local)
 
     @staticmethod

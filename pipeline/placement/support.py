@@ -16,7 +16,7 @@ which a television stands off its stand's middle or an office chair off its desk
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
 
@@ -83,10 +83,14 @@ def half_depth_on(support: np.ndarray, half, yaw: float) -> float:
     return float(abs(np.sin(turn)) * half[0] + abs(np.cos(turn)) * half[1])
 
 
-def back_gap(support: np.ndarray, obj: np.ndarray) -> float:
-    """m between the back edge of ``support (7,)``'s top (its local -y side) and the nearest point of ``obj (7,)``'s
-    footprint, measured along the support (negative: the object overhangs it)."""
-    return float(support[4] - half_depth_on(support, obj[3:5], obj[6]) + to_local(box_frame(support), obj[:2])[1])
+EDGES = {"back": -1.0, "front": 1.0}  # an edge of a support's top: the sign of its side on the support's local y
+
+
+def edge_gap(support: np.ndarray, obj: np.ndarray, edge: str = "back") -> float:
+    """m between the ``edge`` of ``support (7,)``'s top (:data:`EDGES`: ``back`` its local -y side, ``front`` +y) and
+    the nearest point of ``obj (7,)``'s footprint, measured along the support (negative: the object overhangs it)."""
+    local_y = to_local(box_frame(support), obj[:2])[1]
+    return float(support[4] - half_depth_on(support, obj[3:5], obj[6]) - EDGES[edge] * local_y)
 
 
 Key = tuple[str, str, str]
@@ -104,12 +108,13 @@ class Window:
 
 
 def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: float,
-                   facing: float) -> tuple[dict[Key, tuple[np.ndarray, np.ndarray]], dict[Key, list[float]]]:
+                   facing: float) -> tuple[dict[Key, tuple[np.ndarray, np.ndarray]], dict[Key, list[tuple[float, float]]]]:
     """The pairs :func:`learn_centring` reads: (anchor category, object category, kind) -> ``(across (n, 2), along
     (m, 2))``, each row an object's signed offset from the anchor's centre line and the anchor's half extent on that
-    axis (m); and (support category, object category, ``back``) -> the pairs' :func:`back_gap` (m)."""
+    axis (m); and (support category, object category, ``edge``) -> the pairs' :func:`edge_gap` to the back and the front
+    edge (m), in the order of the support rows."""
     seen: dict[Key, tuple[list[tuple[float, float]], list[tuple[float, float]]]] = {}
-    backs: dict[Key, list[float]] = {}
+    gaps: dict[Key, list[tuple[float, float]]] = {}
     for room in rooms:
         b, cats = room.boxes.reshape(-1, 7), room.categories
         for k, j, _ in support_pairs(room, tolerance, floor_contact):
@@ -117,7 +122,7 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
             lines = seen.setdefault((cats[j], cats[k], "support"), ([], []))
             lines[0].append((float(u), float(b[j, 3])))
             lines[1].append((float(v), float(b[j, 4])))
-            backs.setdefault((cats[j], cats[k], "back"), []).append(back_gap(b[j], b[k]))
+            gaps.setdefault((cats[j], cats[k], "edge"), []).append((edge_gap(b[j], b[k]), edge_gap(b[j], b[k], "front")))
         floor = np.flatnonzero(on_floor(b, floor_contact))
         fb, fcats = b[floor], [cats[k] for k in floor]
         off, region = offsets(fb), regions(fb)  # (a, t, 2) m, (a, t) index into REGIONS
@@ -128,7 +133,7 @@ def centre_offsets(rooms: list[RoomInput], tolerance: float, floor_contact: floa
                 seen.setdefault((fcats[a], fcats[t], kind), ([], []))[axis].append((float(off[a, t, axis]),
                                                                                     float(fb[a, 3 + axis])))
     as_rows = lambda rows: np.array(rows, float).reshape(-1, 2)
-    return {key: (as_rows(across), as_rows(along)) for key, (across, along) in seen.items()}, backs
+    return {key: (as_rows(across), as_rows(along)) for key, (across, along) in seen.items()}, gaps
 
 
 def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, floor_contact: float, facing: float,
@@ -140,42 +145,54 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
     stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
     front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
     ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
-    room), across. ``back``: ``(share, gap, reach)``, the share of an object's pairs with its support whose footprint
-    stands within ``flush`` m of the support's back edge (:func:`back_gap`: a monitor at the back of its desk, the
-    ``support`` rule's share along the support then over the other pairs where they pass the window), their median
-    gap (m) and the farthest any pair's centre stood off the support's centre line along its depth (m: a
-    television flush with the back of a deep stand stands farther off it than any training television did). A share
+    room), across. ``back`` | ``front`` (:func:`_edge_rule`): ``(share, gap, reach)``, the share of an object's pairs
+    with its support whose footprint stands within ``flush`` m of the commonest gap to that edge of the support
+    (:func:`edge_gap`: a monitor at the back of its desk, a keyboard 5 cm from its front), their median gap (m) and the
+    farthest any pair's centre stood off the support's centre line along its depth (m: a thin television at the back
+    of a deep stand stands farther off it than any training television did). A share
     needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within 10 cm of a
     narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
-    seen, backs = centre_offsets(rooms, tolerance, floor_contact, facing)
+    seen, gaps = centre_offsets(rooms, tolerance, floor_contact, facing)
     rules: dict[Key, tuple] = {}
     for key, axes in sorted(seen.items()):
         found = [_near_line(pairs, window) for pairs in axes]
         if any(share for share, _ in found):
             rules[key] = CentreLine(found[0][0], found[1][0], found[0][1], found[1][1])
-    for key, gaps in sorted(backs.items()):
-        rules.update(_back_rule(key, np.asarray(gaps), seen[(key[0], key[1], "support")], rules, window, flush))
+    for key, pair_gaps in sorted(gaps.items()):
+        rules.update(_edge_rule(key[:2], np.asarray(pair_gaps), seen[(*key[:2], "support")], rules, window, flush))
     return rules
 
 
-def _back_rule(key: Key, gaps: np.ndarray, lines: tuple[np.ndarray, np.ndarray], rules: dict[Key, tuple],
+def _edge_rule(pair: tuple[str, str], gaps: np.ndarray, lines: tuple[np.ndarray, np.ndarray], rules: dict[Key, tuple],
                window: Window, flush: float) -> dict[Key, tuple]:
-    """The ``back`` rule of one (support, object, ``back``) ``key`` from its pairs' ``gaps (n,)`` (m) and their
-    ``lines`` (:func:`centre_offsets`'s across and along rows, in the same order), with the pair's ``support`` rule
-    whose share along the support is taken over the pairs not at the back where those pass the window on their own (a
-    monitor not at the back of its desk stands at its middle; 11% of them in the procedural office rooms, too few
-    for the share over all pairs). Empty without a share at the back."""
-    flat = np.abs(gaps) <= flush
-    if len(gaps) < window.min_pairs or not flat.any():
+    """The edge rule of one (support, object) ``pair`` from its pairs' ``gaps (n, 2)`` to the back and front edge
+    (m) and their ``lines`` (:func:`centre_offsets`'s across and along rows, in the same order): at the edge whose
+    gaps gather most within ``flush`` of one gap (:func:`_densest`; ties: the nearer edge), if more than the pair's
+    share on the support's middle gather there (a vase centred on a table stands as far from either edge), with the
+    pair's ``support`` rule whose share along the support is taken over the pairs off that edge where those pass the
+    window on their own (a monitor not at the back of its desk stands at its middle; 11% of them in the procedural
+    office rooms, too few for the share over all pairs). Empty without such an edge."""
+    support = (*pair, "support")
+    line = CentreLine(*rules.get(support, (0.0, 0.0)))
+    near = np.stack([_densest(gaps[:, 0], flush), _densest(gaps[:, 1], flush)], axis=1)  # (n, 2)
+    gap = [float(np.median(gaps[near[:, k], k])) for k in range(2)]
+    side = min(range(2), key=lambda k: (-near[:, k].mean(), abs(gap[k])))  # ties: the nearer edge
+    flat = near[:, side]
+    if len(gaps) < window.min_pairs or flat.mean() <= line.along:
         return {}
     reach = float(np.ceil(np.abs(lines[1][:, 0]).max() * 1000) / 1000)
-    out: dict[Key, tuple] = {key: (round(float(flat.mean()), 3), round(float(np.median(gaps[flat])), 3), reach)}
-    support = (key[0], key[1], "support")
-    line = CentreLine(*rules.get(support, (0.0, 0.0)))
+    out: dict[Key, tuple] = {(*pair, list(EDGES)[side]): (round(float(flat.mean()), 3), round(gap[side], 3), reach)}
     along, offsets = _near_line(lines[1][~flat], window)
     if along:
         out[support] = CentreLine(line.across, along, line.across_offsets, offsets)
     return out
+
+
+def _densest(gaps: np.ndarray, flush: float) -> np.ndarray:
+    """``(n,)`` bool: the ``gaps (n,)`` within ``flush`` of the gap that has the most others within ``flush`` of it
+    (the first such: a mode, where a median falls between the two kinds of a bimodal set)."""
+    close = np.abs(gaps[:, None] - gaps[None, :]) <= flush
+    return cast(np.ndarray, close[int(np.argmax(close.sum(axis=1)))])
 
 
 def _near_line(pairs: np.ndarray, window: Window) -> tuple[float, tuple[float, ...]]:
