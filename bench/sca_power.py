@@ -3,6 +3,7 @@ evaluate stage runs, on a finished run's held-out rooms of one room type, for th
 control and any method's generated rooms. The sweep behind docs/benchmarks.md ("An evaluation that can fail"):
 
     .venv/bin/python bench/sca_power.py RUN TYPE [--steps 1000 --width 16 --stride 2 --lr 0.002] [--mpp 0.1]
+        [--patience 3 --check-every 100 --validation 0.2]
         [--only placement,turns,real_vs_real,planit] [--mode per_set|shared]
 
 RUN: a run directory (``snakemake --directory RUN``) with results/splits, filter and ingest shards and
@@ -27,8 +28,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("run", type=Path)
     ap.add_argument("room_type")
-    for key, kind in (("steps", int), ("width", int), ("stride", int), ("lr", float)):
-        ap.add_argument(f"--{key}", type=kind)
+    knobs = (("steps", int), ("width", int), ("stride", int), ("lr", float), ("patience", int), ("check_every", int),
+             ("validation", float))
+    for key, kind in knobs:
+        ap.add_argument(f"--{key.replace('_', '-')}", dest=key, type=kind)
     ap.add_argument("--mode", choices=["per_set", "shared"], default="per_set",
                     help="per_set: a classifier per set, timed one by one; shared: one per fold for all sets")
     ap.add_argument("--mpp", type=float, help="fixed m per pixel (default: each room fitted to the window)")
@@ -36,7 +39,7 @@ def main() -> None:
     args = ap.parse_args()
     cfg = config_mod.validate({"seed": 0})
     ev = cfg["evaluate"]
-    sca_cfg = {**ev["sca"], **{k: getattr(args, k) for k in ("steps", "width", "stride", "lr") if getattr(args, k)}}
+    sca_cfg = {**ev["sca"], **{k: getattr(args, k) for k, _ in knobs if getattr(args, k) is not None}}
     res = args.run / "results"
     shards = lambda pattern: sorted(res.glob(pattern))
     train, real = load_real(args.room_type, read_split(res / f"splits/{args.room_type}.parquet"),

@@ -199,6 +199,32 @@ def test_the_classifier_separates_separable_renders_and_not_identical_ones(separ
     else:
         assert 50.0 <= out["accuracy"] <= 62.0 and out["low"] <= 55.0  # folded: 50 is chance
 
+def test_a_patient_classifier_stops_where_held_out_renders_stop_telling_and_trains_on_where_they_do():
+    """Early stopping (``patience``): on renders like the real ones the held-out loss stops falling and training ends
+    long before its steps, still at chance; on separable ones it trains on and still detects them; without patience
+    every step is taken."""
+    import torch
+
+    from pipeline.evaluation.sca import _fit, classifier, sca
+
+    rng = np.random.default_rng(0)
+    cfg = {**default_config()["evaluate"]["sca"], "steps": 400, "width": 8, "device": "cpu", "patience": 2,
+           "check_every": 25}
+    t = lambda a: torch.as_tensor(np.ascontiguousarray(a.transpose(0, 3, 1, 2)))
+    real, like, red = t(_squares(60, 0, rng)), t(_squares(60, 0, rng)), t(_squares(60, 2, rng))
+    steps = {}
+    for name, other in (("like", like), ("red", red)):
+        torch.manual_seed(0)
+        steps[name] = _fit(classifier(8, 2), real[12:], other[12:], cfg, torch.Generator().manual_seed(0),
+                           (real[:12], other[:12]))
+    assert steps["like"] <= 200 and steps["red"] > 2 * steps["like"]
+    assert _fit(classifier(8, 2), real, like, {**cfg, "steps": 40}, torch.Generator().manual_seed(0), None) == 40
+    real_train, real_test = _squares(60, 0, rng), _squares(60, 0, rng)
+    separable = sca(real_train, real_test, _squares(120, 2, rng), np.arange(120) // 2, cfg, seed=0)
+    alike = sca(real_train, real_test, _squares(120, 0, rng), np.arange(120) // 2, cfg, seed=0)
+    assert separable["accuracy"] >= 95.0 and 50.0 <= alike["accuracy"] <= 62.0
+
+
 def test_one_shared_classifier_scores_each_set_on_its_own_head():
     """The shared mode (one classifier per fold, a head per set): a separable set, a set like the real renders and a
     set made from the held-out renders themselves, trained together; each keeps its own score, halves and test

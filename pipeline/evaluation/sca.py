@@ -13,6 +13,7 @@ set's head only), so each head is a real-vs-that-set classifier on features ever
 own halves, its own test renders and its own score; the work is two trainings instead of two per set."""
 from __future__ import annotations
 
+import copy
 from typing import Any, cast
 
 import numpy as np
@@ -40,17 +41,37 @@ def _batch(x: torch.Tensor, size: int, gen: torch.Generator) -> torch.Tensor:
 
 
 def fit_and_predict(real: torch.Tensor, other: torch.Tensor, test: torch.Tensor, cfg: dict[str, Any], seed: int) -> np.ndarray:
-    """``(t,)`` bool "real" predictions for ``test`` of a fresh classifier trained ``cfg['steps']`` Adam steps on
-    balanced, randomly turned and mirrored batches of ``real`` and ``other`` (``(n, 3, s, s)`` tensors)."""
+    """``(t,)`` bool "real" predictions for ``test`` of a fresh classifier trained up to ``cfg['steps']`` Adam steps on
+    balanced, randomly turned and mirrored batches of ``real`` and ``other`` (``(n, 3, s, s)`` tensors); with
+    ``cfg['patience']``, a ``cfg['validation']`` share of each held out and training stopped where its loss has not
+    fallen for that many checks (every ``cfg['check_every']`` steps), the best weights kept (:func:`_fit`)."""
     torch.manual_seed(seed)
     # channels-last: faster steps on a CPU (torch's stubs do not list Module.to's memory_format)
     net = classifier(cfg["width"], cfg["stride"]).to(real.device, memory_format=torch.channels_last)  # type: ignore[call-overload]
-    opt = torch.optim.Adam(net.parameters(), lr=cfg["lr"])
     gen = torch.Generator().manual_seed(seed)
+    held = None
+    if cfg["patience"] and min(len(real), len(other)) > 1:
+        (real, real_held), (other, other_held) = (_held_out(x, cfg["validation"], gen) for x in (real, other))
+        held = (real_held, other_held)
+    _fit(net, real, other, cfg, gen, held)
+    net.eval()
+    with torch.no_grad():
+        return torch.cat([net(b.contiguous(memory_format=torch.channels_last)).squeeze(1) > 0
+                          for b in test.split(256)]).cpu().numpy()
+
+
+def _fit(net: nn.Module, real: torch.Tensor, other: torch.Tensor, cfg: dict[str, Any], gen: torch.Generator,
+         held: tuple[torch.Tensor, torch.Tensor] | None) -> int:
+    """Train ``net`` in place on balanced batches of ``real`` and ``other``; with ``held`` (real and other renders
+    kept out), stop after ``cfg['patience']`` checks without a lower balanced loss on them and load the best
+    weights. Returns the steps taken."""
+    opt = torch.optim.Adam(net.parameters(), lr=cfg["lr"])
     half = max(cfg["batch_size"] // 2, 1)
     y = torch.cat([torch.ones(half), torch.zeros(half)]).to(real.device)
-    net.train()
-    for _ in range(cfg["steps"]):
+    best, kept, stale = float("inf"), None, 0
+    step = 0
+    while step < cfg["steps"] and (held is None or stale < cfg["patience"]):
+        net.train()
         x = torch.cat([_batch(real, half, gen), _batch(other, half, gen)])
         turn = int(torch.randint(8, (1,), generator=gen))
         x = torch.rot90(x.flip(3) if turn >= 4 else x, turn % 4, (2, 3)).contiguous(memory_format=torch.channels_last)
@@ -58,10 +79,30 @@ def fit_and_predict(real: torch.Tensor, other: torch.Tensor, test: torch.Tensor,
         opt.zero_grad()
         loss.backward()
         opt.step()
+        step += 1
+        if held is not None and step % cfg["check_every"] == 0:
+            checked = _held_loss(net, *held)
+            best, kept, stale = (checked, copy.deepcopy(net.state_dict()), 0) if checked < best else (best, kept,
+                                                                                                       stale + 1)
+    if kept is not None:
+        net.load_state_dict(kept)
+    return step
+
+
+def _held_out(x: torch.Tensor, share: float, gen: torch.Generator) -> tuple[torch.Tensor, torch.Tensor]:
+    """``x`` split at random into the renders to train on and a ``share`` held out (at least one, never all)."""
+    order = torch.randperm(len(x), generator=gen)
+    k = min(max(int(round(share * len(x))), 1), len(x) - 1)
+    return x[order[k:]], x[order[:k]]
+
+
+def _held_loss(net: nn.Module, real: torch.Tensor, other: torch.Tensor) -> float:
+    """The mean of the binary cross-entropies of ``net`` on held-out ``real`` (label 1) and ``other`` (0) renders."""
     net.eval()
     with torch.no_grad():
-        return torch.cat([net(b.contiguous(memory_format=torch.channels_last)).squeeze(1) > 0
-                          for b in test.split(256)]).cpu().numpy()
+        bce = lambda x, label: float(nn.functional.binary_cross_entropy_with_logits(
+            net(x.contiguous(memory_format=torch.channels_last)).squeeze(1), torch.full((len(x),), label, device=x.device)))
+        return (bce(real, 1.0) + bce(other, 0.0)) / 2
 
 
 def no_score() -> dict[str, float]:
