@@ -22,7 +22,7 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import BackToWall, Centred, Combined, FaceAnchor, FaceAway, FacingPartner, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import Kit, instantiate
-from pipeline.placement.support import EDGES, CentreLine, Window, edge_gap, learn_centring
+from pipeline.placement.support import EDGES, OFF_EDGE, CentreLine, Window, edge_gap, learn_centring
 from pipeline.placement.walls import learn_wall_backs
 
 from conftest import Room, default_config
@@ -432,16 +432,17 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
 
 
 def test_objects_not_at_their_supports_back_edge_stand_where_the_training_rooms_others_stand():
-    # learned: 18 of 30 televisions 1 cm from their stands' back edges, 12 on the stand's middle: the share on the
-    # middle is taken over the 12 not at the back (all of them), not over every pair (0.4)
+    # learned: 18 of 30 televisions 1 cm from their stands' back edges, 12 on the stand's middle: the centre lines of
+    # the 12 not at the back (all on the middle), beside those over every pair (0.4 along)
     cfg = default_config()
     flush = cfg["instantiate"]["snap"]["flush_within"]
     mixed = [_tv_at_back(furnished(s), 0.01).room_input() for s in range(18)] + [furnished(s).room_input()
                                                                                 for s in range(18, 30)]
     rules = learn_centring(mixed, Window(0.02), 0.02, cfg["floor_contact"], math.pi / 4, flush)
     assert rules[("tv_stand", "tv", "back")][:2] == (0.6, 0.01)
-    line = rules[("tv_stand", "tv", "support")]
+    line, overall = rules[("tv_stand", "tv", OFF_EDGE)], rules[("tv_stand", "tv", "support")]
     assert line.along == 1.0 and len(line.along_offsets) == 12 and max(map(abs, line.along_offsets)) < 1e-9
+    assert line.across == 1.0 and len(line.across_offsets) == 12 and overall.along == 0.4
     # applied: every television stands at the back edge or on the middle, both seen
     room, walls, pool, checker, cfg = setup_room(furnished(0))
     base = given(room, pool, "tv_stand", "stand", (0.2, 2.0), 270)

@@ -18,7 +18,7 @@ from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .layout import box_frame, wall_frame
-from .support import EDGES, CentreLine, half_depth_on
+from .support import EDGES, OFF_EDGE, CentreLine, half_depth_on
 
 WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
 
@@ -355,10 +355,10 @@ class Centred:
             line = CentreLine(*(rule or (0.0, 0.0)))
             share = np.asarray(line[:2]) * (
                 [1, 1] if a.kind == SUPPORT else [1, 0] if a.direction in ("front", "back") else [0, 1])
-            if edge is not None and rng.random() < edge[1][0]:
-                moved = self._onto_edge(req.room.boxes[a.obj], a.target_half, yaw, edge, xy)
-                if abs(to_local(box_frame(req.room.boxes[a.obj]), moved)[1]) <= edge[1][2]:
-                    xy, share = moved, share * [1, 0]
+            if edge is not None:
+                xy, off = self._onto_edge_or_off(req, a, yaw, edge, xy, rng)
+                line, share = (line, share * [1, 0]) if off is None else (off, np.asarray(off[:2], float)) if len(
+                    off) else (line, share)
             xy = self._onto_line(a.frame, xy, share, line, rng)
         planned = {a.obj for a in req.anchors}
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
@@ -375,6 +375,19 @@ class Centred:
             return np.zeros(0, int)
         boxes = np.vstack([req.room.boxes.reshape(-1, 7), point_box(xy, yaw)])
         return np.flatnonzero(ruled & facing_each_other(boxes, self.facing)[:-1, -1])
+
+    def _onto_edge_or_off(self, req: Request, a: Anchor, yaw: float, edge: tuple[str, tuple], xy: np.ndarray,
+                          rng: np.random.Generator) -> tuple[np.ndarray, tuple | None]:
+        """With the ``edge`` rule's share, ``(xy moved to its gap from that edge of the support a, None)``, unless
+        that lies farther off the support's middle than the rule's reach; else ``(xy, the centre lines of the training
+        pairs off that edge)`` (``()``: none learned, the pair's lines over all its pairs stand)."""
+        support = req.room.boxes[a.obj]
+        if rng.random() < edge[1][0]:
+            moved = self._onto_edge(support, a.target_half, yaw, edge, xy)
+            if abs(to_local(box_frame(support), moved)[1]) <= edge[1][2]:
+                return moved, None
+        off = self.rules.get((req.room.categories[a.obj], req.category, OFF_EDGE))
+        return xy, () if off is None else CentreLine(*off)
 
     def _edge(self, pair: tuple[str, str]) -> tuple[str, tuple] | None:
         """The (support, object) ``pair``'s edge rule, ``(edge, (share, gap, reach))`` (None: none learned)."""

@@ -84,6 +84,7 @@ def half_depth_on(support: np.ndarray, half, yaw: float) -> float:
 
 
 EDGES = {"back": -1.0, "front": 1.0}  # an edge of a support's top: the sign of its side on the support's local y
+OFF_EDGE = "off_edge"  # kind of the centre lines of the pairs of a (support, object) edge rule that stand off its edge
 
 
 def edge_gap(support: np.ndarray, obj: np.ndarray, edge: str = "back") -> float:
@@ -165,15 +166,14 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
 
 def _edge_rule(pair: tuple[str, str], gaps: np.ndarray, lines: tuple[np.ndarray, np.ndarray], rules: dict[Key, tuple],
                window: Window, flush: float) -> dict[Key, tuple]:
-    """The edge rule of one (support, object) ``pair`` from its pairs' ``gaps (n, 2)`` to the back and front edge
-    (m) and their ``lines`` (:func:`centre_offsets`'s across and along rows, in the same order): at the edge whose
-    gaps gather most within ``flush`` of one gap (:func:`_densest`; ties: the nearer edge), if more than the pair's
-    share on the support's middle gather there (a vase centred on a table stands as far from either edge), with the
-    pair's ``support`` rule whose share along the support is taken over the pairs off that edge where those pass the
-    window on their own (a monitor not at the back of its desk stands at its middle; 11% of them in the procedural
-    office rooms, too few for the share over all pairs). Empty without such an edge."""
-    support = (*pair, "support")
-    line = CentreLine(*rules.get(support, (0.0, 0.0)))
+    """The edge rule of one (support, object) ``pair`` from its pairs' ``gaps (n, 2)`` to the back and front edge (m)
+    and their ``lines`` (:func:`centre_offsets`'s across and along rows, in the same order): at the edge whose gaps
+    gather most within ``flush`` of one gap (:func:`_densest`; ties: the nearer edge), if more than the pair's share on
+    the support's middle gather there (a vase centred on a table stands as far from either edge); with the
+    :class:`CentreLine` of the pairs off that edge (:data:`OFF_EDGE`) where those pass the window on their own: the
+    11% of the procedural offices' monitors not at the back of their desk stand on its centre, both ways, which the
+    lines over all pairs do not say. Empty without such an edge."""
+    line = CentreLine(*rules.get((*pair, "support"), (0.0, 0.0)))
     near = np.stack([_densest(gaps[:, 0], flush), _densest(gaps[:, 1], flush)], axis=1)  # (n, 2)
     gap = [float(np.median(gaps[near[:, k], k])) for k in range(2)]
     side = min(range(2), key=lambda k: (-near[:, k].mean(), abs(gap[k])))  # ties: the nearer edge
@@ -182,9 +182,9 @@ def _edge_rule(pair: tuple[str, str], gaps: np.ndarray, lines: tuple[np.ndarray,
         return {}
     reach = float(np.ceil(np.abs(lines[1][:, 0]).max() * 1000) / 1000)
     out: dict[Key, tuple] = {(*pair, list(EDGES)[side]): (round(float(flat.mean()), 3), round(gap[side], 3), reach)}
-    along, offsets = _near_line(lines[1][~flat], window)
-    if along:
-        out[support] = CentreLine(line.across, along, line.across_offsets, offsets)
+    rest = [_near_line(axis[~flat], window) for axis in lines]
+    if any(share for share, _ in rest):
+        out[(*pair, OFF_EDGE)] = CentreLine(rest[0][0], rest[1][0], rest[0][1], rest[1][1])
     return out
 
 
