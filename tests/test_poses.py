@@ -490,6 +490,23 @@ def test_two_objects_facing_each_other_stand_on_one_axis_as_in_the_training_room
     assert min(abs(u) for u in beside) > 1.0
 
 
+def test_an_object_planned_in_front_of_an_anchor_it_faces_takes_the_facing_pairs_line():
+    # the spatial rule (chairs in front of desks at large) puts half the chairs 0.3 m off the desk's line; a chair
+    # that faces its desk at the drawn pose takes the facing rule (every facing pair on the line) instead
+    room, walls, pool, checker, cfg = setup_room(furnished(0))
+    desk = given(room, pool, "desk", "desk", (2.7, 0.3), 0)
+    plan = plan_of("c", "chair", [PlanEdge("desk", "c", "spatial", "front", "adjacent")])
+    drawn = FaceAnchor(Combined(RelationPrior(cfg["extract"]), FaceAway()), {("desk", "chair"): 1.0})
+    spatial = {("desk", "chair", "spatial"): CentreLine(1.0, 0.0, (0.3, -0.3), (0.0,))}
+    chairs = lambda rules: [placed(instantiate(plan, desk, [0], Centred(drawn, rules), Kit(pool, checker),
+                                               cfg["instantiate"], seed), "c") for seed in SEEDS]
+    across = lambda chair: to_local(box_frame(desk.boxes[0]), chair[:2])[0]
+    faced = [facing_each_other(np.vstack([desk.boxes[0], c]), math.pi / 4)[0, 1] for c in chairs(spatial)]
+    assert all(faced) and min(abs(across(c)) for c in chairs(spatial)) > 0.29
+    both = {**spatial, ("desk", "chair", "facing"): CentreLine(1.0, 0.0, (0.0,), (0.0,))}
+    assert max(abs(across(c)) for c in chairs(both)) < 1e-9
+
+
 def _chairs_turned(rooms: list[Room], every: int) -> list[Room]:
     """``rooms`` with the chair of every ``every``-th room turned a quarter turn (its side to its desk)."""
     for r in rooms[::every]:

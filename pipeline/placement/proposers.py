@@ -330,8 +330,10 @@ class Centred:
     pair's (a thin television at the back of a deep stand, the stand's middle no longer under it), else with each
     share's probability the drawn place's offset across (along) the support is replaced by one of the training
     pairs' offsets near the line, drawn uniformly; beside a placed floor anchor planned in front of or behind it,
-    the offset across it, and planned left or right of it, the offset along it; a floor object facing a placed
-    object with no planned edge to it, the two facing each other within ``facing`` rad at the drawn pose
+    the offset across it (by the pair's ``facing`` line where planned in front of it and turned to face it back: an
+    office chair facing its desk stands closer to the desk's line than chairs in front of desks at large), and
+    planned left or right of it, the offset along it; a floor object facing a placed object with no planned edge to
+    it, the two facing each other within ``facing`` rad at the drawn pose
     (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it. A drawn place is only as fine as
     the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
     proposer's.
@@ -350,6 +352,8 @@ class Centred:
                 continue
             pair = (req.room.categories[a.obj], req.category)
             rule, edge = self.rules.get((*pair, a.kind)), self._edge(pair) if a.kind == SUPPORT else None
+            if a.kind != SUPPORT and a.direction == "front" and self._turned_to(req, a.obj, yaw):
+                rule = self.rules.get((*pair, "facing"), rule)
             if rule is None and edge is None:
                 continue
             line = CentreLine(*(rule or (0.0, 0.0)))
@@ -366,6 +370,11 @@ class Centred:
                 line = CentreLine(*self.rules[(req.room.categories[o], req.category, "facing")])
                 xy = self._onto_line(box_frame(req.room.boxes[o]), xy, np.array([line.across, 0.0]), line, rng)
         return xy, yaw
+
+    def _turned_to(self, req: Request, obj: int, yaw: float) -> bool:
+        """Whether a drawn turn ``yaw`` (rad) faces the placed object ``obj`` back within ``facing``: planned in front
+        of it, the two then face each other on its line."""
+        return bool(abs(turn_error(yaw - req.room.boxes.reshape(-1, 7)[obj, 6] - np.pi)) <= self.facing)
 
     def _facing(self, req: Request, xy: np.ndarray, yaw: float) -> np.ndarray:
         """Indices of the placed objects with a ``facing`` rule for the requested category that face each other with
