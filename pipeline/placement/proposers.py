@@ -329,11 +329,12 @@ class Centred:
     keyboard at its front) unless that puts its centre farther off the support's centre line than any training
     pair's (a thin television at the back of a deep stand, the stand's middle no longer under it), else with each
     share's probability the drawn place's offset across (along) the support is replaced by one of the training
-    pairs' offsets near the line, drawn uniformly; beside a placed floor anchor planned in front of or behind it,
-    the offset across it (by the pair's ``facing`` line where planned in front of it and turned to face it back: an
-    office chair facing its desk stands closer to the desk's line than chairs in front of desks at large), and
-    planned left or right of it, the offset along it; a floor object facing a placed object with no planned edge to
-    it, the two facing each other within ``facing`` rad at the drawn pose
+    pairs' offsets near the line, drawn uniformly, and with an edge rule the offset along its depth is kept within
+    the training pairs' (no television in front of its stand's middle); beside a placed floor anchor planned in
+    front of or behind it, the offset across it (by the pair's ``facing`` line where planned in front of it and
+    turned to face it back: an office chair facing its desk stands closer to the desk's line than chairs in front of
+    desks at large), and planned left or right of it, the offset along it; a floor object facing a placed object
+    with no planned edge to it, the two facing each other within ``facing`` rad at the drawn pose
     (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it. A drawn place is only as fine as
     the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
     proposer's.
@@ -364,6 +365,8 @@ class Centred:
                 line, share = (line, share * [1, 0]) if off is None else (off, np.asarray(off[:2], float)) if len(
                     off) else (line, share)
             xy = self._onto_line(a.frame, xy, share, line, rng)
+            if edge is not None:
+                xy = self._within(req.room.boxes[a.obj], xy, edge[1][2:])
         planned = {a.obj for a in req.anchors}
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
             if o not in planned:
@@ -388,18 +391,27 @@ class Centred:
     def _onto_edge_or_off(self, req: Request, a: Anchor, yaw: float, edge: tuple[str, tuple], xy: np.ndarray,
                           rng: np.random.Generator) -> tuple[np.ndarray, tuple | None]:
         """With the ``edge`` rule's share, ``(xy moved to its gap from that edge of the support a, None)``, unless
-        that lies farther off the support's middle than the rule's reach; else ``(xy, the centre lines of the training
+        that lies beyond the rule's offsets from the support's middle (low, high); else ``(xy, the centre lines of the training
         pairs off that edge)`` (``()``: none learned, the pair's lines over all its pairs stand)."""
         support = req.room.boxes[a.obj]
         if rng.random() < edge[1][0]:
             moved = self._onto_edge(support, a.target_half, yaw, edge, xy)
-            if abs(to_local(box_frame(support), moved)[1]) <= edge[1][2]:
+            if edge[1][2] <= to_local(box_frame(support), moved)[1] <= edge[1][3]:
                 return moved, None
         off = self.rules.get((req.room.categories[a.obj], req.category, OFF_EDGE))
         return xy, () if off is None else CentreLine(*off)
 
+    @staticmethod
+    def _within(support: np.ndarray, xy: np.ndarray, reach: tuple[float, float]) -> np.ndarray:
+        """``xy`` with its offset from ``support (7,)``'s centre line along its depth clipped to ``reach`` (low, high;
+        m): never farther behind or in front of the middle than any training pair stood."""
+        frame = box_frame(support)
+        local = to_local(frame, xy)
+        local[1] = np.clip(local[1], *reach)
+        return to_world(frame, local)
+
     def _edge(self, pair: tuple[str, str]) -> tuple[str, tuple] | None:
-        """The (support, object) ``pair``'s edge rule, ``(edge, (share, gap, reach))`` (None: none learned)."""
+        """The (support, object) ``pair``'s edge rule, ``(edge, (share, gap, low, high))`` (None: none learned)."""
         return next(((e, self.rules[(*pair, e)]) for e in EDGES if (*pair, e) in self.rules), None)
 
     @staticmethod

@@ -146,11 +146,12 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
     stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
     front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
     ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
-    room), across. ``back`` | ``front`` (:func:`_edge_rule`): ``(share, gap, reach)``, the share of an object's pairs
+    room), across. ``back`` | ``front`` (:func:`_edge_rule`): ``(share, gap, low, high)``, the share of an object's pairs
     with its support whose footprint stands within ``flush`` m of the commonest gap to that edge of the support
     (:func:`edge_gap`: a monitor at the back of its desk, a keyboard 5 cm from its front), their median gap (m) and the
-    farthest any pair's centre stood off the support's centre line along its depth (m: a thin television at the back
-    of a deep stand stands farther off it than any training television did). A share
+    lowest and highest offset of any pair's centre from the support's centre line along its depth (m, signed: a thin
+    television at the back of a deep stand stands farther behind it than any training television did, one in front
+    of it where none did). A share
     needs the window's pairs and concentration (:class:`Window`), else it is 0: plants stand within 10 cm of a
     narrow anchor's centre line by chance; rules whose shares are both 0 are left out."""
     seen, gaps = centre_offsets(rooms, tolerance, floor_contact, facing)
@@ -180,8 +181,9 @@ def _edge_rule(pair: tuple[str, str], gaps: np.ndarray, lines: tuple[np.ndarray,
     flat = near[:, side]
     if len(gaps) < window.min_pairs or flat.mean() <= line.along:
         return {}
-    reach = float(np.ceil(np.abs(lines[1][:, 0]).max() * 1000) / 1000)
-    out: dict[Key, tuple] = {(*pair, list(EDGES)[side]): (round(float(flat.mean()), 3), round(gap[side], 3), reach)}
+    along = lines[1][:, 0]
+    reach = (float(np.floor(along.min() * 1000) / 1000), float(np.ceil(along.max() * 1000) / 1000))
+    out: dict[Key, tuple] = {(*pair, list(EDGES)[side]): (round(float(flat.mean()), 3), round(gap[side], 3), *reach)}
     rest = [_near_line(axis[~flat], window) for axis in lines]
     if any(share for share, _ in rest):
         out[(*pair, OFF_EDGE)] = CentreLine(rest[0][0], rest[1][0], rest[0][1], rest[1][1])
