@@ -22,7 +22,7 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import BackToWall, Centred, Combined, FaceAnchor, FaceAway, FacingPartner, RelationPrior, UniformLocation
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import Kit, instantiate
-from pipeline.placement.support import EDGES, OFF_EDGE, CentreLine, Window, edge_gap, learn_centring
+from pipeline.placement.support import EDGES, OFF_EDGE, CentreLine, EdgeRule, Window, edge_gap, learn_centring
 from pipeline.placement.walls import learn_wall_backs
 
 from conftest import Room, default_config
@@ -375,7 +375,7 @@ def test_edge_gap_reads_flush_overhanging_and_turned_footprints_and_onto_back_in
     for support in (desk, turned):
         for _ in range(20):
             yaw, xy = rng.uniform(-math.pi, math.pi), support[:2] + rng.uniform(-0.3, 0.3, 2)
-            moved = Centred._onto_edge(support, (0.2, 0.1), yaw, ("back", (1.0, 0.016, -1.0, 1.0)), xy)
+            moved = Centred._onto_edge(support, (0.2, 0.1), yaw, ("back", EdgeRule(1.0, 0.016, -1.0, 1.0)), xy)
             assert edge_gap(support, box(*moved, yaw)) == pytest.approx(0.016)
             assert to_local(box_frame(support), moved)[0] == pytest.approx(to_local(box_frame(support), xy)[0])
 

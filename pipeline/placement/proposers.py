@@ -18,7 +18,7 @@ from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .layout import box_frame, wall_frame
-from .support import EDGES, OFF_EDGE, CentreLine, half_depth_on
+from .support import EDGES, OFF_EDGE, CentreLine, EdgeRule, half_depth_on
 
 WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
 
@@ -361,12 +361,15 @@ class Centred:
             share = np.asarray(line[:2]) * (
                 [1, 1] if a.kind == SUPPORT else [1, 0] if a.direction in ("front", "back") else [0, 1])
             if edge is not None:
-                xy, off = self._onto_edge_or_off(req, a, yaw, edge, xy, rng)
-                line, share = (line, share * [1, 0]) if off is None else (off, np.asarray(off[:2], float)) if len(
-                    off) else (line, share)
+                moved = self._at_edge(req.room.boxes[a.obj], a.target_half, yaw, edge, xy, rng)
+                if moved is not None:
+                    xy, share = moved, share * [1, 0]
+                elif (*pair, OFF_EDGE) in self.rules:  # the centre lines of the training pairs off that edge
+                    line = CentreLine(*self.rules[(*pair, OFF_EDGE)])
+                    share = np.asarray(line[:2], float)
             xy = self._onto_line(a.frame, xy, share, line, rng)
             if edge is not None:
-                xy = self._within(req.room.boxes[a.obj], xy, edge[1][2:])
+                xy = self._within(req.room.boxes[a.obj], xy, edge[1])
         planned = {a.obj for a in req.anchors}
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
             if o not in planned:
@@ -388,39 +391,36 @@ class Centred:
         boxes = np.vstack([req.room.boxes.reshape(-1, 7), point_box(xy, yaw)])
         return np.flatnonzero(ruled & facing_each_other(boxes, self.facing)[:-1, -1])
 
-    def _onto_edge_or_off(self, req: Request, a: Anchor, yaw: float, edge: tuple[str, tuple], xy: np.ndarray,
-                          rng: np.random.Generator) -> tuple[np.ndarray, tuple | None]:
-        """With the ``edge`` rule's share, ``(xy moved to its gap from that edge of the support a, None)``, unless
-        that lies beyond the rule's offsets from the support's middle (low, high); else ``(xy, the centre lines of the training
-        pairs off that edge)`` (``()``: none learned, the pair's lines over all its pairs stand)."""
-        support = req.room.boxes[a.obj]
-        if rng.random() < edge[1][0]:
-            moved = self._onto_edge(support, a.target_half, yaw, edge, xy)
-            if edge[1][2] <= to_local(box_frame(support), moved)[1] <= edge[1][3]:
-                return moved, None
-        off = self.rules.get((req.room.categories[a.obj], req.category, OFF_EDGE))
-        return xy, () if off is None else CentreLine(*off)
+    def _at_edge(self, support: np.ndarray, half, yaw: float, edge: tuple[str, EdgeRule], xy: np.ndarray,
+                 rng: np.random.Generator) -> np.ndarray | None:
+        """With the ``edge`` rule's share, ``xy`` moved to its gap from that edge of ``support (7,)``
+        (:meth:`_onto_edge`); None where not drawn, or where the move lies beyond the rule's low and high offsets from
+        the support's middle."""
+        if rng.random() >= edge[1].share:
+            return None
+        moved = self._onto_edge(support, half, yaw, edge, xy)
+        return moved if edge[1].low <= to_local(box_frame(support), moved)[1] <= edge[1].high else None
 
     @staticmethod
-    def _within(support: np.ndarray, xy: np.ndarray, reach: tuple[float, float]) -> np.ndarray:
-        """``xy`` with its offset from ``support (7,)``'s centre line along its depth clipped to ``reach`` (low, high;
-        m): never farther behind or in front of the middle than any training pair stood."""
+    def _within(support: np.ndarray, xy: np.ndarray, rule: EdgeRule) -> np.ndarray:
+        """``xy`` with its offset from ``support (7,)``'s centre line along its depth clipped to the ``rule``'s low and
+        high (m): never farther behind or in front of the middle than any training pair stood."""
         frame = box_frame(support)
         local = to_local(frame, xy)
-        local[1] = np.clip(local[1], *reach)
+        local[1] = np.clip(local[1], rule.low, rule.high)
         return to_world(frame, local)
 
-    def _edge(self, pair: tuple[str, str]) -> tuple[str, tuple] | None:
-        """The (support, object) ``pair``'s edge rule, ``(edge, (share, gap, low, high))`` (None: none learned)."""
-        return next(((e, self.rules[(*pair, e)]) for e in EDGES if (*pair, e) in self.rules), None)
+    def _edge(self, pair: tuple[str, str]) -> tuple[str, EdgeRule] | None:
+        """The (support, object) ``pair``'s edge rule, ``(edge, rule)`` (None: none learned)."""
+        return next(((e, EdgeRule(*self.rules[(*pair, e)])) for e in EDGES if (*pair, e) in self.rules), None)
 
     @staticmethod
-    def _onto_edge(support: np.ndarray, half, yaw: float, edge: tuple[str, tuple], xy: np.ndarray) -> np.ndarray:
+    def _onto_edge(support: np.ndarray, half, yaw: float, edge: tuple[str, EdgeRule], xy: np.ndarray) -> np.ndarray:
         """``xy`` moved along ``support (7,)`` so that a footprint of half extents ``half (2,)`` turned ``yaw`` stands
         the ``edge`` rule's gap from that edge (:func:`~pipeline.placement.support.edge_gap`)."""
         frame = box_frame(support)
         local = to_local(frame, xy)
-        local[1] = EDGES[edge[0]] * (support[4] - half_depth_on(support, half, yaw) - edge[1][1])
+        local[1] = EDGES[edge[0]] * (support[4] - half_depth_on(support, half, yaw) - edge[1].gap)
         return to_world(frame, local)
 
     @staticmethod

@@ -94,6 +94,17 @@ def edge_gap(support: np.ndarray, obj: np.ndarray, edge: str = "back") -> float:
     return float(support[4] - half_depth_on(support, obj[3:5], obj[6]) - EDGES[edge] * local_y)
 
 
+class EdgeRule(NamedTuple):
+    """Where the training pairs of one (support category, object category) stand at an edge of the support
+    (:func:`_edge_rule`): the ``share`` of pairs at the edge, their median ``gap`` to it (m), and the ``low`` and
+    ``high`` signed offset of any pair's centre from the support's centre line along its depth (m)."""
+
+    share: float
+    gap: float
+    low: float
+    high: float
+
+
 Key = tuple[str, str, str]
 
 
@@ -146,7 +157,7 @@ def learn_centring(rooms: list[RoomInput], window: Window, tolerance: float, flo
     stands on (both lines); ``spatial``: two floor objects, across over the pairs whose object stands in the anchor's
     front or back region, along over those in its side regions; ``facing``: two floor objects facing each other within
     ``facing`` rad (:func:`~pipeline.geometry.function.facing_each_other`: a sofa and the television stand across the
-    room), across. ``back`` | ``front`` (:func:`_edge_rule`): ``(share, gap, low, high)``, the share of an object's pairs
+    room), across. ``back`` | ``front`` (:func:`_edge_rule`): an :class:`EdgeRule`, the share of an object's pairs
     with its support whose footprint stands within ``flush`` m of the commonest gap to that edge of the support
     (:func:`edge_gap`: a monitor at the back of its desk, a keyboard 5 cm from its front), their median gap (m) and the
     lowest and highest offset of any pair's centre from the support's centre line along its depth (m, signed: a thin
@@ -183,7 +194,8 @@ def _edge_rule(pair: tuple[str, str], gaps: np.ndarray, lines: tuple[np.ndarray,
         return {}
     along = lines[1][:, 0]
     reach = (float(np.floor(along.min() * 1000) / 1000), float(np.ceil(along.max() * 1000) / 1000))
-    out: dict[Key, tuple] = {(*pair, list(EDGES)[side]): (round(float(flat.mean()), 3), round(gap[side], 3), *reach)}
+    out: dict[Key, tuple] = {(*pair, list(EDGES)[side]): EdgeRule(round(float(flat.mean()), 3), round(gap[side], 3),
+                                                                  *reach)}
     rest = [_near_line(axis[~flat], window) for axis in lines]
     if any(share for share, _ in rest):
         out[(*pair, OFF_EDGE)] = CentreLine(rest[0][0], rest[1][0], rest[0][1], rest[1][1])
