@@ -267,6 +267,8 @@ SCHEMAS["eval_scenes"] = pa.schema([
     _f("contents_excess", _F64, doc="1: a category more often than in any training room of the type"),
     _f("contents_missing", _F64, doc="1: a category missing that the training rooms hold with confidence"),
     _f("functional_all", _F64, doc="1: every applicable functional check passes and the contents are plausible"),
+    _f("failed_checks", pa.list_(_STR), doc="the functional checks the room fails (<target>@<anchor> or "
+       "<target>@wall) and contents_excess / contents_missing where they hold"),
 ])
 SCHEMAS["superstructures"] = pa.schema([
     _f("room_id", _STR, nullable=False), _f("room_type", _CAT),

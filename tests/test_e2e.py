@@ -295,6 +295,9 @@ def test_generated_rooms_baselines_and_real_rooms_are_scored_alike(run_dir):
         assert tables.metadata(res / "eval" / room_type / "scenes.parquet")["pipeline.schema"] == "eval_scenes/v1"
         assert rows.groupby("set").size().to_dict() == {k: v["scenes"] for k, v in m["sets"].items() if v["scenes"]}
         assert rows.walkable_share.between(0, 1).all() and rows.nn_similarity.between(0, 1).all()
+        assert ((rows.failed_checks.str.len() == 0) == (rows.functional_all == 1.0)).all()  # a failing room names why
+        assert {c for cs in rows.failed_checks for c in cs} <= {c[3:] for c in m["checks"]} | {"contents_excess",
+                                                                                               "contents_missing"}
 
 
 def test_the_annealing_methods_learn_readable_programs_and_their_rooms_are_scored(run_dir):

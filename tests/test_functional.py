@@ -11,7 +11,7 @@ import shapely
 
 from pipeline.evaluation import functional, intervals, perturb, power
 from pipeline.geometry.boxes import footprint_corners
-from pipeline.geometry.function import REGIONS, back_to_wall, facing_angles, footprint_gaps, plan_gaps, regions
+from pipeline.geometry.function import REGIONS, back_to_wall, faces_wall, facing_angles, footprint_gaps, plan_gaps, regions
 
 from conftest import Room, default_config
 
@@ -51,6 +51,17 @@ def test_footprint_gaps_match_shapely_distances():
     assert footprint_gaps(b[:4], b) == pytest.approx(want[:4], abs=1e-12)
     assert plan_gaps(b) == pytest.approx(want, abs=1e-12)
     assert footprint_gaps(b[0], b[1])[0, 0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_a_pose_faces_a_wall_only_squarely_and_within_the_walls_extent():
+    """A wall (0, 0)-(4, 0) facing +y: faced from above it squarely or turned 30 degrees (also from just beyond its
+    end, the ray still meeting it); not turned along it, not from beyond its end facing straight down (the sofa of an
+    L-shaped living room beyond the inner corner's short wall), not from behind it."""
+    a, b, normal, limit = np.array([0.0, 0.0]), np.array([4.0, 0.0]), np.array([0.0, 1.0]), np.pi / 4
+    xy = np.array([[2.0, 2.0], [2.0, 2.0], [2.0, 2.0], [6.0, 2.0], [2.0, -1.0], [4.5, 2.0]])
+    yaw = np.radians([180.0, 150.0, 90.0, 180.0, 180.0, 150.0])  # front -y, or turned 30 degrees toward -x; 90: -x
+    assert faces_wall(xy, yaw, a, b, normal, limit).tolist() == [True, True, False, False, False, True]
+    assert not faces_wall(xy[:1], np.radians(120.0), a, b, normal, limit)[0]  # 60 degrees off square
 
 
 def test_the_predicates_place_a_nightstand_at_the_head_and_a_chair_facing_its_desk():

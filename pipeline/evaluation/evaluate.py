@@ -80,13 +80,21 @@ def room_rows(rs: RoomSet, learned: dict[str, Any], index: dict[str, int],
     (``models``: meshes, box-only models and the model -> symmetry table)."""
     meshes, box_models, symmetry = models
     scored = pd.DataFrame(scene_rows(rs, meshes, box_models, train_maps, train_ids, index, config),
-                          columns=[c for c in tables.SCHEMAS["eval_scenes"].names if c not in functional.ROOM_COLUMNS])
+                          columns=[c for c in tables.SCHEMAS["eval_scenes"].names
+                                   if c not in (*functional.ROOM_COLUMNS, "failed_checks")])
     fn = pd.DataFrame([functional.score_room(r, learned, config["evaluate"]["functional"], symmetry) for r in rs.rooms],
                       index=scored.index, columns=[*map(functional.check_name, learned["checks"]),
                                                    *functional.ROOM_COLUMNS], dtype=float)
     counts = pd.DataFrame([Counter(r.categories) for r in rs.rooms], index=scored.index,
                           columns=sorted(index)).fillna(0).add_prefix(intervals.CATEGORY)
-    return pd.concat([scored, fn, counts], axis=1)
+    failed = pd.Series([failed_checks(o) for o in fn.to_dict("records")], index=scored.index, name="failed_checks")
+    return pd.concat([scored, fn, counts, failed], axis=1)
+
+
+def failed_checks(outcomes: dict[str, float]) -> list[str]:
+    """The checks one room fails (outcome 0.0, ``fn:`` prefix dropped), then the contents flags it raises."""
+    flags = [k for k in ("contents_excess", "contents_missing") if outcomes[k] == 1.0]
+    return [k[3:] for k, v in outcomes.items() if k.startswith("fn:") and v == 0.0] + flags
 
 
 def off_axis_shares(rooms: list[RoomInput], symmetry: dict[str, str], angle_deg: float) -> dict[str, Any]:

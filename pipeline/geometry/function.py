@@ -88,6 +88,24 @@ def facing_turn(anchor: np.ndarray, xy: np.ndarray) -> float:
     return float(boxes[0, 6] + SIDE_FACING_TURNS[sides(boxes, corners=False)[0, 1]])
 
 
+def faces_wall(xy: np.ndarray, yaw: ArrayLike, a: np.ndarray, b: np.ndarray, normal: np.ndarray,
+               limit: float) -> np.ndarray:
+    """``(m,)`` bool: a pose at ``xy (m, 2)`` turned ``yaw (m,)`` faces the wall segment ``a``-``b`` (``(2,)`` each)
+    whose inward unit ``normal (2,)`` is given: its front turned within ``limit`` rad of the wall's outward normal
+    (square to it, so that whatever stands with its back to the wall faces it back) and its front ray meeting the
+    segment. A sofa facing the wall its television stand will stand against; not a wall it sees along its length."""
+    xy, yaw = np.asarray(xy, float).reshape(-1, 2), np.broadcast_to(np.asarray(yaw, float), (len(xy),))
+    front = np.stack([-np.sin(yaw), np.cos(yaw)], -1)
+    square = np.arccos(np.clip(front @ -np.asarray(normal, float), -1.0, 1.0)) <= limit
+    along, rel = np.asarray(b, float) - a, np.asarray(a, float) - xy  # segment a + s * along meets xy + t * front
+    cross = lambda u, v: u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+    den = cross(front, along)
+    ok = np.abs(den) > 1e-12
+    t = np.where(ok, cross(rel, along) / np.where(ok, den, 1.0), -1.0)
+    s = np.where(ok, cross(rel, front) / np.where(ok, den, 1.0), -1.0)
+    return cast(np.ndarray, square & (t > 0) & (s >= 0) & (s <= 1))
+
+
 def _corner_edge_gaps(ca: np.ndarray, cb: np.ndarray) -> np.ndarray:
     """``(k, m)`` least distance from a corner of each footprint ``ca (k, 4, 2)`` to an edge of each
     ``cb (m, 4, 2)``."""

@@ -12,13 +12,14 @@ import numpy as np
 
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d, point_box
-from ..geometry.frames import to_local, to_world, turn_error
-from ..geometry.function import facing_angles, facing_each_other, facing_turn
+from ..geometry.frames import to_local, to_world, turn_error, wrap
+from ..geometry.function import faces_wall, facing_angles, facing_each_other, facing_turn
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .layout import box_frame, wall_frame
 from .support import EDGES, OFF_EDGE, CentreLine, EdgeRule, half_depth_on
+from .turns import QUARTER, SupportTurn
 
 WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
 
@@ -227,9 +228,10 @@ class FacingPartner:
     one is kept; where none does, the first that does once turned to squarely face the side of the nearest partner its
     place lies beyond (:func:`~pipeline.geometry.function.facing_turn`; a turn drawn, as a wall back, goes first; never
     turned away from a planned anchor it faced as drawn), else the first drawn. With no partner placed yet, a
-    partner the plan puts against a wall later (:attr:`Request.ahead`: a sofa placed before its television stand)
-    stands in as that wall: the object is drawn facing the wall's segment. A partner the object has a planned edge to
-    is the plan's; an object on a support has none."""
+    partner the plan puts against a wall later (:attr:`Request.ahead`: a sofa placed before the television stand the
+    plan puts in front of it, or says nothing of) stands in as that wall: the object is drawn squarely facing the
+    wall's segment (:func:`~pipeline.geometry.function.faces_wall`), so that the partner, back to the wall, faces it
+    back. A placed partner the object has a planned edge to is the plan's; an object on a support has none."""
 
     def __init__(self, base, shares: dict[tuple[str, str], float], facing: float, tries: int):
         self.base, self.shares, self.facing, self.tries = base, shares, facing, tries
@@ -238,15 +240,15 @@ class FacingPartner:
         first = self.base.pose(req, rng)
         if first is None or any(a.kind == SUPPORT for a in req.anchors):
             return first
-        partners, share, boxes, wall = self._partners(req), 0.0, req.room.boxes.reshape(-1, 7), False
+        partners, share, boxes, wall = self._partners(req), 0.0, req.room.boxes.reshape(-1, 7), None
         if len(partners):
             share = max(self.shares[(req.room.categories[o], req.category)] for o in partners)
             boxes = boxes[partners]
         else:
             later = [(self.shares[(c, req.category)], w) for c, w in req.ahead if (c, req.category) in self.shares]
             if later:
-                share, w = max(later)
-                boxes, wall = self._wall_box(req, w), True
+                share, wall = max(later)
+                boxes = self._wall_box(req, wall)
         if not share or rng.random() >= share:
             return first
         turned: tuple[np.ndarray, float] | None = None
@@ -255,10 +257,10 @@ class FacingPartner:
             if drawn is None:
                 break
             xy, yaw = drawn
-            if self._faces(boxes, xy, yaw, wall):
+            if self._faces(req, boxes, xy, yaw, wall):
                 return drawn
             turn = facing_turn(boxes[np.argmin(np.linalg.norm(boxes[:, :2] - xy, axis=1))], xy)
-            if turned is None and self._faces(boxes, xy, turn, wall) and self._keeps(req, xy, yaw, turn):
+            if turned is None and self._faces(req, boxes, xy, turn, wall) and self._keeps(req, xy, yaw, turn):
                 turned = (xy, turn)
         return turned or first
 
@@ -278,12 +280,14 @@ class FacingPartner:
         angles = facing_angles(boxes)[:-2, -2:]  # (planned, drawn | turned)
         return bool(np.all((angles[:, 0] > self.facing) | (angles[:, 1] <= self.facing)))
 
-    def _faces(self, partners: np.ndarray, xy: np.ndarray, yaw: float, wall: bool) -> bool:
-        """A pose at ``xy`` turned ``yaw`` faces one of ``partners (m, 7)``: each within ``facing`` of the other (a
-        ``wall``'s box, :meth:`_wall_box`: only the pose's front counts)."""
+    def _faces(self, req: Request, partners: np.ndarray, xy: np.ndarray, yaw: float, wall: int | None) -> bool:
+        """A pose at ``xy`` turned ``yaw`` faces one of ``partners (m, 7)``: each within ``facing`` of the other; or,
+        standing in for a partner placed later against ``wall``, faces that wall squarely and meets it
+        (:func:`~pipeline.geometry.function.faces_wall`: what stands there with its back to it faces the pose)."""
+        if wall is not None:
+            walls = req.walls
+            return bool(faces_wall(xy, yaw, walls.a[wall], walls.b[wall], walls.normal[wall], self.facing)[0])
         boxes = np.vstack([partners, point_box(xy, yaw)])
-        if wall:
-            return bool(facing_angles(boxes)[:-1, -1].min() <= self.facing)
         return bool(facing_each_other(boxes, self.facing)[:-1, -1].any())
 
     @staticmethod
@@ -291,6 +295,29 @@ class FacingPartner:
         """``(1, 7)``: wall ``w``'s segment as a box of depth :data:`WALL_DEPTH` whose front faces into the room."""
         mid, half = (req.walls.a[w] + req.walls.b[w]) / 2, req.walls.length[w] / 2
         return np.array([[mid[0], mid[1], 0.0, half, WALL_DEPTH, 0.0, wall_frame(req.walls, w).yaw]])
+
+
+class TurnedOnSupport:
+    """A proposer whose objects on a support turn to it as the training rooms' objects of their category turn to a
+    support of its category (``rules``: (support category, object category) -> :class:`~pipeline.placement.turns.
+    SupportTurn`): the drawn turn's nearest quarter turn of the support among those the training pairs stand at
+    (counting the object's equivalent fronts), plus one of that quarter's training residuals drawn uniformly. A monitor
+    stands square to its desk within the few degrees training monitors do, never sideways; the place stays drawn."""
+
+    def __init__(self, base, rules: dict[tuple[str, str], SupportTurn]):
+        self.base, self.rules = base, rules
+
+    def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        drawn = self.base.pose(req, rng)
+        support = next((a.obj for a in req.anchors if a.kind == SUPPORT and a.obj is not None), None)
+        rule = None if support is None else self.rules.get((req.room.categories[support], req.category))
+        if drawn is None or rule is None:
+            return drawn
+        xy, yaw = drawn
+        turns = req.room.boxes.reshape(-1, 7)[support, 6] + np.array(rule.quarters) * QUARTER
+        k = int(np.argmin(turn_error(turns - yaw, req.symmetry)))
+        residuals = rule.residuals[k]
+        return xy, float(wrap(turns[k] + residuals[rng.integers(len(residuals))]))
 
 
 class Combined(DensityProposer):

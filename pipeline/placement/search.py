@@ -306,10 +306,11 @@ class Search:
                        mask, self.ahead(v)), pk
 
     def ahead(self, v: str) -> tuple[tuple[str, int], ...]:
-        """The plan's objects not placed yet with no planned edge to ``v``, as (category, wall index) of each wall it
-        is planned adjacent to (:attr:`~pipeline.placement.proposers.Request.ahead`)."""
+        """The plan's objects not placed yet that are not ``v``'s anchors (no edge, or one from ``v``: a television
+        stand the plan puts in front of the sofa placed first), as (category, wall index) of each wall it is planned
+        adjacent to (:attr:`~pipeline.placement.proposers.Request.ahead`)."""
         placed, wall = set(self.room.object_ids), {w: k for k, w in enumerate(self.walls.ids)}
-        joined = {e.source if e.target == v else e.target for e in self.plan.edges if v in (e.source, e.target)}
+        joined = {e.source for e in self.plan.edges if e.target == v}
         return tuple((self.plan.categories[self.plan.index(e.target)], wall[e.source]) for e in self.plan.edges
                      if e.source in wall and e.edge_type == "spatial" and e.distance == "adjacent"
                      and e.target in self.plan.ids and e.target not in placed | joined | {v})

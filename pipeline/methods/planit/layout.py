@@ -22,6 +22,7 @@ from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
 from ...placement.search import SCORED, Kit, instantiate
 from ...placement.support import Window, learn_centring
+from ...placement.turns import learn_support_turns
 from ...placement.walls import learn_wall_backs
 from ...seeding import seed_of
 from ..interface import Corpus, Scene, Task
@@ -39,11 +40,13 @@ class PoseRules:
     objects against a wall that have their back to it (:func:`~pipeline.placement.walls.learn_wall_backs`); per
     (partner, object) category the share of objects facing a partner (:func:`~pipeline.placement.facing.
     learn_facing_partners`) and of objects near an anchor facing it (:func:`~pipeline.placement.facing.
-    learn_anchor_facing`)."""
+    learn_anchor_facing`); per (support, object) category the quarter turns and residual turns of objects on a
+    support (:func:`~pipeline.placement.turns.learn_support_turns`)."""
     centring: dict = field(default_factory=dict)
     wall_backs: dict = field(default_factory=dict)
     partners: dict = field(default_factory=dict)
     anchor_facing: dict = field(default_factory=dict)
+    support_turns: dict = field(default_factory=dict)
 
 
 def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRules | None = None):
@@ -53,6 +56,7 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRul
     ``rules``, objects planned beside an anchor turned to face it (:class:`~pipeline.placement.proposers.FaceAnchor`)
     or against a wall with their back to it (:class:`~pipeline.placement.proposers.BackToWall`), drawn facing the
     placed objects the training rooms' objects face unplanned (:class:`~pipeline.placement.proposers.FacingPartner`),
+    turned on their support as the training rooms' objects are (:class:`~pipeline.placement.proposers.TurnedOnSupport`)
     and put on the centre lines of their supports, planned floor anchors and the placed objects they face
     (:class:`~pipeline.placement.proposers.Centred`)."""
     base = location_proposer(location, saved, cfg, extract)
@@ -65,6 +69,8 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRul
         base = proposers.BackToWall(base, rules.wall_backs)
     if rules.partners:
         base = proposers.FacingPartner(base, rules.partners, facing, cfg["snap"]["partner_tries"])
+    if rules.support_turns:
+        base = proposers.TurnedOnSupport(base, rules.support_turns)
     if rules.centring:
         base = proposers.Centred(base, rules.centring, facing)
     return base
@@ -72,23 +78,27 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRul
 
 def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
     """The training rooms' pose rules (``instantiate.snap``'s settings): centre lines and back edges of objects on
-    supports, beside floor anchors and facing each other; backs to walls; facing partners and anchors."""
+    supports, beside floor anchors and facing each other; backs to walls; facing partners and anchors; turns on
+    supports."""
     snap, floor = config["instantiate"]["snap"], config["floor_contact"]
     training, facing = corpus.training(), np.radians(snap["centre_facing_angle"])
+    tolerance = config["instantiate"]["checks"]["learned_support"]["tolerance"]
     window = Window(snap["centre_within"], snap["centre_min_pairs"], snap["centre_concentration"], snap["centre_fraction"])
     rules = PoseRules(
-        learn_centring(training, window, config["instantiate"]["checks"]["learned_support"]["tolerance"], floor, facing,
-                       snap["flush_within"]),
+        learn_centring(training, window, tolerance, floor, facing, snap["flush_within"]),
         learn_wall_backs(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]), snap["centre_min_pairs"],
                          floor) if snap["wall_back_gap"] > 0 else {},
         learn_facing_partners(training, facing, snap["centre_min_pairs"], snap["facing_min_share"], floor)
         if snap["partner_tries"] else {},
         learn_anchor_facing(training, snap["face_anchor_gap"], facing, snap["centre_min_pairs"], snap["facing_min_share"],
-                            floor) if snap["face_anchor_gap"] > 0 else {})
+                            floor) if snap["face_anchor_gap"] > 0 else {},
+        learn_support_turns(training, tolerance, floor, snap["centre_min_pairs"], snap["support_turn_min_share"])
+        if snap["support_turns"] else {})
     named = lambda rule: {"/".join(key): (tuple(v[:2]) if isinstance(v, tuple) else v) for key, v in rule.items()}
     log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s; facing "
-             "partners %s; facing anchors %s", corpus.room_type, named(rules.centring), rules.wall_backs,
-             named(rules.partners), named(rules.anchor_facing))
+             "partners %s; facing anchors %s; quarter turns on supports %s", corpus.room_type, named(rules.centring),
+             rules.wall_backs, named(rules.partners), named(rules.anchor_facing),
+             {"/".join(k): v.quarters for k, v in rules.support_turns.items()})
     return rules
 
 
