@@ -183,3 +183,27 @@ def test_a_learned_overhang_never_goes_below_half_the_footprint():
     checks = {**default_config()["instantiate"]["checks"], "min_support": 0.9}
     rooms = [_tv_room(k, 3.0) for k in range(12)]  # a 3 m TV on a 0.9 m stand: share 0.3
     assert learn_support_floor(rooms, checks, 0.04) == {"tv": 0.5}
+
+
+def test_an_object_whose_plan_puts_a_placed_object_around_it_is_turned_so_that_it_stands_there():
+    # a table turned 30 degrees at the room's middle; a chair drawn 1.2 m beyond its left side, planned with the table
+    # in front of it (behind it, on its left, on its right): the turn puts the table on that side of the chair; with
+    # no edge from the chair to a placed object the base orienter's turn stands (facing away from the nearest wall)
+    from pipeline.placement.anchors import anchors_of
+    from pipeline.placement.proposers import FaceAway, FacePlanned, Grid, Request
+
+    from test_poses import furnished, given, plan_of, setup_room
+
+    room, walls, pool, _, _ = setup_room(furnished(0))
+    placed = given(room, pool, "desk", "table", (2.2, 2.3), 30)
+    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    xy = np.array([2.2, 2.3]) + np.array([[c, -s], [s, c]]) @ [-1.2, 0.1]
+    for direction in SIDES:
+        plan = plan_of("c", "chair", [PlanEdge("c", "table", "spatial", direction, "adjacent")])
+        anchors = anchors_of("c", plan, placed, walls, {}, (0.25, 0.25))
+        req = Request(placed, walls, "chair", "left-right", anchors, Grid(placed.outline, 0.1), np.ones(1, bool))
+        yaw = FacePlanned(FaceAway()).orientation(req, xy, np.random.default_rng(0))
+        boxes = np.vstack([[*xy, 0.45, 0.25, 0.25, 0.45, yaw], placed.boxes.reshape(-1, 7)])
+        assert SIDES[sides(boxes, corners=False)[0, 1]] == direction
+    alone = Request(placed, walls, "chair", "left-right", [], Grid(placed.outline, 0.1), np.ones(1, bool))
+    assert FacePlanned(FaceAway()).orientation(alone, xy, None) == FaceAway().orientation(alone, xy, None)

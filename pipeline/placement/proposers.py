@@ -177,6 +177,27 @@ class FaceAway:
         return wall_frame(req.walls, nearest_wall(req.walls, xy)).yaw
 
 
+class FacePlanned:
+    """Turned so that a placed object the plan puts around it stands there: with an edge from the object to a placed
+    one (a reverse anchor), the turn that squarely faces the side of that object its place lies beyond
+    (:func:`~pipeline.geometry.function.facing_turn`), then turned so that it lies in the edge's direction (front: as
+    is; back: half a turn; left, right: a quarter turn); a dining chair whose plan puts the table in front of it faces
+    the table. Else the ``base`` orienter's turn. The plan's own relations, nothing learned: for proposers with no
+    orientation model (the relation bands)."""
+
+    TURN = {"front": 0.0, "back": np.pi, "left": -np.pi / 2, "right": np.pi / 2}
+
+    def __init__(self, base):
+        self.base = base
+
+    def orientation(self, req: Request, xy: np.ndarray, rng: np.random.Generator) -> float:
+        ahead = [a for a in req.anchors if a.reverse and a.obj is not None and a.direction in self.TURN]
+        if not ahead:
+            return self.base.orientation(req, xy, rng)
+        a = ahead[0]
+        return float(wrap(facing_turn(req.room.boxes.reshape(-1, 7)[a.obj], xy) + self.TURN[a.direction]))
+
+
 class BackToWall:
     """A proposer whose objects planned adjacent to a wall stand with their back to one of those walls as often as the
     training rooms' objects of their category do against a wall (``shares``:

@@ -1,5 +1,6 @@
 """Re-instantiating real rooms' own graphs, no network needed: each room is emptied and its objects placed again
-from its extracted graph by the search with the relation-band proposer, then extracted again. How the search does
+from its extracted graph by the search with the relation-band proposer (turned to what the plan puts around each
+object, else away from the nearest wall), then extracted again. How the search does
 on real furniture meshes and real room shapes (tests, bench/front3d_instantiate.py)."""
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from . import order, scene_metrics
 from .checks import Checker, checks_config
 from .layout import walls_of, with_objects
 from .plan import plans_from_tables
-from .proposers import Combined, FaceAway, RelationPrior
+from .proposers import Combined, FaceAway, FacePlanned, RelationPrior
 from .retrieval import ModelPool
 from .search import Kit, instantiate
 
@@ -43,7 +44,7 @@ def reinstantiate(frames: dict[str, pd.DataFrame], models: tuple[dict, set, dict
         room = with_objects(inputs[plan.room_id], [])
         walls = walls_of(room)
         out = instantiate(plan, room, order.placement_order(plan, areas),
-                          Combined(RelationPrior(config["extract"]), FaceAway()), Kit(pool, checker), ic, seed)
+                          Combined(RelationPrior(config["extract"]), FacePlanned(FaceAway())), Kit(pool, checker), ic, seed)
         m = scene_metrics.consistency(plan, out.room, walls.ids, checker)
         rows.append({"room_id": plan.room_id, "objects": len(plan.ids), "placed": out.status == "placed", "reason": out.reason,
                      "seconds": out.seconds, "backtracks": out.backtracks, "attempts": out.attempts, **m,
