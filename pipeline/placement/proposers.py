@@ -17,6 +17,7 @@ from ..geometry.function import faces_wall, facing_angles, facing_each_other, fa
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
+from .facing import AnchorFacing
 from .layout import box_frame, wall_frame
 from .support import EDGES, OFF_EDGE, CentreLine, EdgeRule, half_depth_on
 from .turns import QUARTER, SupportTurn
@@ -221,23 +222,28 @@ class BackToWall:
 
 class FaceAnchor:
     """A proposer whose floor objects planned beside a placed floor anchor face it as often as the training rooms'
-    objects of their category face one of the anchor's category standing near it (``shares``: (anchor category,
-    object category) -> share, :func:`~pipeline.placement.facing.learn_anchor_facing`): with the largest share among
-    the planned anchors, the drawn turn becomes the one that squarely faces the side of that anchor the drawn place
-    lies beyond (:func:`~pipeline.geometry.function.facing_turn`: an office chair in front of its desk turns to the
-    desk); the place stays drawn."""
+    objects of their category face one of the anchor's category standing near it (``rules``: (anchor category,
+    object category) -> :class:`~pipeline.placement.facing.AnchorFacing`): with the largest share among the planned
+    anchors, the drawn turn becomes the one that squarely faces the side of that anchor the drawn place lies beyond
+    (:func:`~pipeline.geometry.function.facing_turn`: an office chair in front of its desk turns to the desk), turned
+    by one of the training pairs' turns off square, drawn uniformly; the place stays drawn."""
 
-    def __init__(self, base, shares: dict[tuple[str, str], float]):
-        self.base, self.shares = base, shares
+    def __init__(self, base, rules: dict[tuple[str, str], AnchorFacing]):
+        self.base, self.rules = base, rules
 
     def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
         drawn = self.base.pose(req, rng)
-        ruled = [(self.shares.get((req.room.categories[a.obj], req.category), 0.0), a.obj) for a in req.anchors
+        none = AnchorFacing(0.0)
+        ruled = [(self.rules.get((req.room.categories[a.obj], req.category), none), a.obj) for a in req.anchors
                  if a.obj is not None and a.kind == "spatial" and not a.reverse]
-        if drawn is None or not ruled or any(a.kind == SUPPORT for a in req.anchors) or rng.random() >= max(ruled)[0]:
+        if drawn is None or not ruled or any(a.kind == SUPPORT for a in req.anchors):
+            return drawn
+        rule, obj = max(ruled, key=lambda r: (r[0].share, r[1]))
+        if rng.random() >= rule.share:
             return drawn
         xy, _ = drawn
-        return xy, facing_turn(req.room.boxes.reshape(-1, 7)[max(ruled)[1]], xy)
+        off = rule.residuals[rng.integers(len(rule.residuals))]
+        return xy, float(wrap(facing_turn(req.room.boxes.reshape(-1, 7)[obj], xy) + off))
 
 
 class FacingPartner:

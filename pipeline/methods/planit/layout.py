@@ -97,7 +97,7 @@ def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
     named = lambda rule: {"/".join(key): (tuple(v[:2]) if isinstance(v, tuple) else v) for key, v in rule.items()}
     log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s; facing "
              "partners %s; facing anchors %s; quarter turns on supports %s", corpus.room_type, named(rules.centring),
-             rules.wall_backs, named(rules.partners), named(rules.anchor_facing),
+             rules.wall_backs, named(rules.partners), {"/".join(k): v.share for k, v in rules.anchor_facing.items()},
              {"/".join(k): v.quarters for k, v in rules.support_turns.items()})
     return rules
 
