@@ -207,3 +207,14 @@ def test_an_object_whose_plan_puts_a_placed_object_around_it_is_turned_so_that_i
         assert SIDES[sides(boxes, corners=False)[0, 1]] == direction
     alone = Request(placed, walls, "chair", "left-right", [], Grid(placed.outline, 0.1), np.ones(1, bool))
     assert FacePlanned(FaceAway()).orientation(alone, xy, None) == FaceAway().orientation(alone, xy, None)
+    # planned against the bottom wall with objects to come behind it (and on its left): the side toward the wall is
+    # the first the plan leaves free, back, left, right, then front
+    bottom = walls.ids.index(next(w for w, (a, b) in zip(walls.ids, zip(walls.a, walls.b)) if a[1] == b[1] == 0.0))
+    plan = plan_of("t", "desk", [PlanEdge(walls.ids[bottom], "t", "spatial", "front", "adjacent")])
+    anchors = anchors_of("t", plan, room, walls, {}, (0.6, 0.3))
+    toward = {"back": -np.pi / 2, "left": np.pi, "right": 0.0, "front": np.pi / 2}  # the side's world direction: -y
+    for later, side in (((), "back"), (("back",), "left"), (("back", "left"), "right"),
+                        (("back", "left", "right"), "front")):
+        req = Request(room, walls, "desk", "none", anchors, Grid(room.outline, 0.1), np.ones(1, bool), (), later)
+        yaw = FacePlanned(FaceAway()).orientation(req, np.array([2.0, 0.5]), None)
+        assert abs(turn_error(yaw + toward[side] + np.pi / 2)) < 1e-9, (later, side, np.degrees(yaw))

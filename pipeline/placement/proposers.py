@@ -30,7 +30,9 @@ class Request:
     """The object being placed: its category and symmetry, its anchors (:class:`~pipeline.placement.anchors.Anchor`)
     in the room as it stands, the candidate centres (:class:`Grid`) and which of them are allowed ``mask (cells,)``
     (on the floor or its support's top, off what stands there, outside rejected squares); ``ahead``: the plan's objects
-    not placed yet that have no planned edge to it, as (category, index of the wall it is planned adjacent to)."""
+    not placed yet that are not its anchors, as (category, index of the wall it is planned adjacent to);
+    ``later_sides``: the directions of its planned spatial edges to objects not placed yet (the sides the plan fills
+    later)."""
     room: RoomInput
     walls: Walls
     category: str
@@ -39,6 +41,7 @@ class Request:
     grid: "Grid"
     mask: np.ndarray
     ahead: tuple[tuple[str, int], ...] = ()
+    later_sides: tuple[str, ...] = ()
 
     @property
     def points(self) -> np.ndarray:
@@ -179,24 +182,31 @@ class FaceAway:
 
 
 class FacePlanned:
-    """Turned so that a placed object the plan puts around it stands there: with an edge from the object to a placed
+    """Turned so that what the plan puts around the object can stand there. With an edge from the object to a placed
     one (a reverse anchor), the turn that squarely faces the side of that object its place lies beyond
     (:func:`~pipeline.geometry.function.facing_turn`), then turned so that it lies in the edge's direction (front: as
-    is; back: half a turn; left, right: a quarter turn); a dining chair whose plan puts the table in front of it faces
-    the table. Else the ``base`` orienter's turn. The plan's own relations, nothing learned: for proposers with no
-    orientation model (the relation bands)."""
+    is; back: half a turn; left, right: a quarter turn): a dining chair whose plan puts the table in front of it faces
+    the table. Else, planned adjacent to a wall, square to it with a side the plan leaves free toward it
+    (:attr:`Request.later_sides`; back first, then left, right, front): a dining table against a wall with chairs
+    planned behind and before it stands end-on. Else the ``base`` orienter's turn. The plan's own relations, nothing
+    learned: for proposers with no orientation model (the relation bands)."""
 
     TURN = {"front": 0.0, "back": np.pi, "left": -np.pi / 2, "right": np.pi / 2}
+    TO_WALL = {"back": 0.0, "left": np.pi / 2, "right": -np.pi / 2, "front": np.pi}  # the side toward the wall
 
     def __init__(self, base):
         self.base = base
 
     def orientation(self, req: Request, xy: np.ndarray, rng: np.random.Generator) -> float:
         ahead = [a for a in req.anchors if a.reverse and a.obj is not None and a.direction in self.TURN]
-        if not ahead:
-            return self.base.orientation(req, xy, rng)
-        a = ahead[0]
-        return float(wrap(facing_turn(req.room.boxes.reshape(-1, 7)[a.obj], xy) + self.TURN[a.direction]))
+        walls = [a.wall for a in req.anchors if a.wall is not None and a.distance == "adjacent" and not a.reverse]
+        if ahead:
+            a = ahead[0]
+            return float(wrap(facing_turn(req.room.boxes.reshape(-1, 7)[a.obj], xy) + self.TURN[a.direction]))
+        if walls:
+            free = next((side for side in ("back", "left", "right") if side not in req.later_sides), "front")
+            return float(wrap(wall_frame(req.walls, walls[0]).yaw + self.TO_WALL[free]))
+        return self.base.orientation(req, xy, rng)
 
 
 class BackToWall:

@@ -302,8 +302,11 @@ class Search:
             r = r if scene is None else scene
             mask &= (np.abs(self.grid.points[:, 0] - x) > r) | (np.abs(self.grid.points[:, 1] - y) > r)
         anchors = anchors_of(v, self.plan, self.room, self.walls, self.sym, half)
+        placed = set(self.room.object_ids)
+        later = tuple(e.direction for e in self.plan.edges if e.source == v and e.edge_type == "spatial"
+                      and e.target in self.plan.ids and e.target not in placed and e.direction is not None)
         return Request(self.room, self.walls, self.plan.categories[k], self.plan.symmetry[k], anchors, self.grid,
-                       mask, self.ahead(v)), pk
+                       mask, self.ahead(v), later), pk
 
     def ahead(self, v: str) -> tuple[tuple[str, int], ...]:
         """The plan's objects not placed yet that are not ``v``'s anchors (no edge, or one from ``v``: a television
