@@ -186,9 +186,9 @@ class FacePlanned:
     one (a reverse anchor), the turn that squarely faces the side of that object its place lies beyond
     (:func:`~pipeline.geometry.function.facing_turn`), then turned so that it lies in the edge's direction (front: as
     is; back: half a turn; left, right: a quarter turn): a dining chair whose plan puts the table in front of it faces
-    the table. Else, planned adjacent to a wall, square to it with a side the plan leaves free toward it
-    (:attr:`Request.later_sides`; back first, then left, right, front): a dining table against a wall with chairs
-    planned behind and before it stands end-on. Else the ``base`` orienter's turn. The plan's own relations, nothing
+    the table. Else, planned adjacent to walls, square to the nearest of them with a side the plan leaves free
+    toward it (:attr:`Request.later_sides`; back first, then left, right, front): a dining table against a wall with
+    chairs planned behind and before it stands end-on. Else the ``base`` orienter's turn. The plan's own relations, nothing
     learned: for proposers with no orientation model (the relation bands)."""
 
     TURN = {"front": 0.0, "back": np.pi, "left": -np.pi / 2, "right": np.pi / 2}
@@ -205,7 +205,8 @@ class FacePlanned:
             return float(wrap(facing_turn(req.room.boxes.reshape(-1, 7)[a.obj], xy) + self.TURN[a.direction]))
         if walls:
             free = next((side for side in ("back", "left", "right") if side not in req.later_sides), "front")
-            return float(wrap(wall_frame(req.walls, walls[0]).yaw + self.TO_WALL[free]))
+            w = walls[int(nearest_segment(np.asarray(xy, float), req.walls.segments[walls])[1])]
+            return float(wrap(wall_frame(req.walls, w).yaw + self.TO_WALL[free]))
         return self.base.orientation(req, xy, rng)
 
 
