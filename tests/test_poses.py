@@ -450,8 +450,9 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
     offsets = [to_local(box_frame(r.boxes.reshape(-1, 7)[r.object_ids.index("stand")]),
                         r.boxes.reshape(-1, 7)[r.object_ids.index("tv"), :2])[1] for r in at_back]
     assert rules[("tv_stand", "tv", "back")][:2] == (1.0, 0.01)
-    low, high = rules[("tv_stand", "tv", "back")][2:]
+    low, high, across_low, across_high = rules[("tv_stand", "tv", "back")][2:]
     assert min(offsets) - 0.001 < low <= min(offsets) and max(offsets) <= high < max(offsets) + 0.001
+    assert -0.001 <= across_low <= 0.0 <= across_high <= 0.001  # every training TV on the stand's middle across it
     assert learn([_tv_at_back(furnished(s), 0.05).room_input() for s in range(12)])[("tv_stand", "tv", "back")][:2] == (
         1.0, 0.05)
     assert ("tv_stand", "tv", "back") not in learn([_tv_at_back(furnished(s), 0.01).room_input() for s in range(9)])
@@ -477,6 +478,11 @@ def test_objects_stand_at_their_supports_back_edge_as_often_as_in_the_training_r
     assert max(abs(to_local(box_frame(base.boxes[0]), tv(beyond, seed)[:2])[1]) for seed in SEEDS) <= 0.001 + 1e-9
     at_front = Centred(uniform, {("tv_stand", "tv", "front"): (1.0, 0.02, -1.0, 1.0)})
     assert max(abs(edge_gap(base.boxes[0], tv(at_front, seed), "front") - 0.02) for seed in SEEDS) < 1e-9
+    # and across the stand within the training TVs' offsets (5 cm either side of the middle), wherever drawn
+    across = lambda proposer: [to_local(box_frame(base.boxes[0]), tv(proposer, seed)[:2])[0] for seed in SEEDS]
+    assert max(map(abs, across(at_back))) > 0.05
+    narrow = Centred(uniform, {("tv_stand", "tv", "back"): (1.0, 0.01, -1.0, 1.0, -0.05, 0.05)})
+    assert max(map(abs, across(narrow))) <= 0.05 + 1e-9
 
 
 def test_objects_not_at_their_supports_back_edge_stand_where_the_training_rooms_others_stand():

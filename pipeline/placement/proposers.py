@@ -468,11 +468,12 @@ class Centred:
 
     @staticmethod
     def _within(support: np.ndarray, xy: np.ndarray, rule: EdgeRule) -> np.ndarray:
-        """``xy`` with its offset from ``support (7,)``'s centre line along its depth clipped to the ``rule``'s low and
-        high (m): never farther behind or in front of the middle than any training pair stood."""
+        """``xy`` with its offsets from ``support (7,)``'s centre lines clipped to the ``rule``'s (m): never farther
+        behind, in front of or beside the middle than any training pair stood."""
         frame = box_frame(support)
         local = to_local(frame, xy)
         local[1] = np.clip(local[1], rule.low, rule.high)
+        local[0] = np.clip(local[0], rule.across_low, rule.across_high)
         return to_world(frame, local)
 
     def _edge(self, pair: tuple[str, str]) -> tuple[str, EdgeRule] | None:

@@ -96,13 +96,17 @@ def edge_gap(support: np.ndarray, obj: np.ndarray, edge: str = "back") -> float:
 
 class EdgeRule(NamedTuple):
     """Where the training pairs of one (support category, object category) stand at an edge of the support
-    (:func:`_edge_rule`): the ``share`` of pairs at the edge, their median ``gap`` to it (m), and the ``low`` and
-    ``high`` signed offset of any pair's centre from the support's centre line along its depth (m)."""
+    (:func:`_edge_rule`): the ``share`` of pairs at the edge, their median ``gap`` to it (m), the ``low`` and
+    ``high`` signed offset of any pair's centre from the support's centre line along its depth (m), and the same
+    across its width (``across_low``, ``across_high``; a monitor never farther off its desk's middle than any training
+    monitor stood)."""
 
     share: float
     gap: float
     low: float
     high: float
+    across_low: float = -np.inf
+    across_high: float = np.inf
 
 
 Key = tuple[str, str, str]
@@ -192,10 +196,9 @@ def _edge_rule(pair: tuple[str, str], gaps: np.ndarray, lines: tuple[np.ndarray,
     flat = near[:, side]
     if len(gaps) < window.min_pairs or flat.mean() <= line.along:
         return {}
-    along = lines[1][:, 0]
-    reach = (float(np.floor(along.min() * 1000) / 1000), float(np.ceil(along.max() * 1000) / 1000))
+    span = lambda v: (float(np.floor(v.min() * 1000) / 1000), float(np.ceil(v.max() * 1000) / 1000))
     out: dict[Key, tuple] = {(*pair, list(EDGES)[side]): EdgeRule(round(float(flat.mean()), 3), round(gap[side], 3),
-                                                                  *reach)}
+                                                                  *span(lines[1][:, 0]), *span(lines[0][:, 0]))}
     rest = [_near_line(axis[~flat], window) for axis in lines]
     if any(share for share, _ in rest):
         out[(*pair, OFF_EDGE)] = CentreLine(rest[0][0], rest[1][0], rest[0][1], rest[1][1])
