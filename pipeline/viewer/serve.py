@@ -21,7 +21,8 @@ def serve(page: Path, host: str = "127.0.0.1", port: int = 8000, announce=print)
     def stop(*_):
         raise KeyboardInterrupt
 
-    previous = signal.signal(signal.SIGTERM, stop)
+    # both handled here: a command started in the background of a shell inherits SIGINT ignored
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGTERM, signal.SIGINT)}
     announce(f"serving http://{host}:{server.server_address[1]}/{page.name} (Ctrl-C stops)")
     try:
         server.serve_forever()
@@ -29,5 +30,6 @@ def serve(page: Path, host: str = "127.0.0.1", port: int = 8000, announce=print)
         pass
     finally:
         server.server_close()
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
         announce("stopped")
