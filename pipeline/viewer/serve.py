@@ -30,6 +30,6 @@ def serve(page: Path, host: str = "127.0.0.1", port: int = 8000, announce=print)
         pass
     finally:
         server.server_close()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        for sig, before in previous.items():
+            signal.signal(sig, before)
         announce("stopped")
