@@ -93,7 +93,7 @@ def room_rows(rs: RoomSet, learned: dict[str, Any], index: dict[str, int],
 
 def failed_checks(outcomes: dict[str, float]) -> list[str]:
     """The checks one room fails (outcome 0.0, ``fn:`` prefix dropped), then the contents flags it raises."""
-    flags = [k for k in ("contents_excess", "contents_missing") if outcomes[k] == 1.0]
+    flags = [k for k in functional.ROOM_COLUMNS if k != "functional_all" and outcomes[k] == 1.0]
     return [k[3:] for k, v in outcomes.items() if k.startswith("fn:") and v == 0.0] + flags
 
 

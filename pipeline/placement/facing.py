@@ -77,8 +77,8 @@ def learn_anchor_facing(rooms: list[RoomInput], gap: float, facing: float, min_p
     off: dict[Pair, list[float]] = {}
     for room in rooms:
         b = room.boxes.reshape(-1, 7)
-        fb = b[on_floor(b, floor_contact)]
-        cats = [c for c, k in zip(room.categories, on_floor(b, floor_contact)) if k]
+        floor = on_floor(b, floor_contact)
+        fb, cats = b[floor], [c for c, k in zip(room.categories, floor) if k]
         near, faces = plan_gaps(fb) <= gap, facing_angles(fb) <= facing  # (anchor, object)
         np.fill_diagonal(near, False)
         for a, t in zip(*np.nonzero(near)):

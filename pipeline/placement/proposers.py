@@ -191,8 +191,7 @@ class FacePlanned:
     chairs planned behind and before it stands end-on. Else the ``base`` orienter's turn. The plan's own relations, nothing
     learned: for proposers with no orientation model (the relation bands)."""
 
-    TURN = {"front": 0.0, "back": np.pi, "left": -np.pi / 2, "right": np.pi / 2}
-    TO_WALL = {"back": 0.0, "left": np.pi / 2, "right": -np.pi / 2, "front": np.pi}  # the side toward the wall
+    TURN = {"front": 0.0, "back": np.pi, "left": -np.pi / 2, "right": np.pi / 2}  # from facing it, side toward it
 
     def __init__(self, base):
         self.base = base
@@ -206,7 +205,7 @@ class FacePlanned:
         if walls:
             free = next((side for side in ("back", "left", "right") if side not in req.later_sides), "front")
             w = walls[int(nearest_segment(np.asarray(xy, float), req.walls.segments[walls])[1])]
-            return float(wrap(wall_frame(req.walls, w).yaw + self.TO_WALL[free]))
+            return float(wrap(wall_frame(req.walls, w).yaw + np.pi + self.TURN[free]))  # + pi: facing the wall
         return self.base.orientation(req, xy, rng)
 
 

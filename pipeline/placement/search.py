@@ -302,11 +302,8 @@ class Search:
             r = r if scene is None else scene
             mask &= (np.abs(self.grid.points[:, 0] - x) > r) | (np.abs(self.grid.points[:, 1] - y) > r)
         anchors = anchors_of(v, self.plan, self.room, self.walls, self.sym, half)
-        placed = set(self.room.object_ids)
-        later = tuple(e.direction for e in self.plan.edges if e.source == v and e.edge_type == "spatial"
-                      and e.target in self.plan.ids and e.target not in placed and e.direction is not None)
         return Request(self.room, self.walls, self.plan.categories[k], self.plan.symmetry[k], anchors, self.grid,
-                       mask, self.ahead(v), later), pk
+                       mask, self.ahead(v), self.later_sides(v)), pk
 
     def ahead(self, v: str) -> tuple[tuple[str, int], ...]:
         """The plan's objects not placed yet that are not ``v``'s anchors (no edge, or one from ``v``: a television
@@ -317,6 +314,13 @@ class Search:
         return tuple((self.plan.categories[self.plan.index(e.target)], wall[e.source]) for e in self.plan.edges
                      if e.source in wall and e.edge_type == "spatial" and e.distance == "adjacent"
                      and e.target in self.plan.ids and e.target not in placed | joined | {v})
+
+    def later_sides(self, v: str) -> tuple[str, ...]:
+        """The directions of ``v``'s planned spatial edges to objects not placed yet
+        (:attr:`~pipeline.placement.proposers.Request.later_sides`)."""
+        placed = set(self.room.object_ids)
+        return tuple(e.direction for e in self.plan.edges if e.source == v and e.edge_type == "spatial"
+                     and e.target in self.plan.ids and e.target not in placed and e.direction is not None)
 
     def propose(self, k: int):
         """A candidate box and pose for object ``k``, or None when no allowed candidate has mass."""
