@@ -95,6 +95,12 @@ def test_a_nightstand_at_the_foot_and_a_chair_facing_away_fail_their_checks(lear
     assert foot["fn:nightstand@bed"] == 0.0 and foot["functional_all"] == 0.0
     away = functional.score_room(bedroom(0.1, chair_yaw=0.0), checks, cfg)
     assert away["fn:chair@desk"] == 0.0 and away["fn:nightstand@bed"] == 1.0
+    # the scenes table names them: none for the good room, the chair's for the turned one, flags for odd contents
+    from pipeline.evaluation.evaluate import failed_checks
+
+    assert failed_checks(good) == [] and "nightstand@bed" in failed_checks(foot)
+    assert "chair@desk" in failed_checks(away) and "nightstand@bed" not in failed_checks(away)
+    assert failed_checks(functional.score_room(bedroom(0.1, beds=2), checks, cfg))[-1] == "contents_excess"
 
 
 def test_implausible_contents_are_flagged(learned):
