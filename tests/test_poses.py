@@ -35,7 +35,7 @@ from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import Kit, instantiate
 from pipeline.placement.support import EDGES, OFF_EDGE, CentreLine, EdgeRule, Window, edge_gap, learn_centring
 from pipeline.placement.turns import learn_support_turns
-from pipeline.placement.walls import learn_wall_backs
+from pipeline.placement.walls import learn_wall_backs, learn_wall_bound
 
 from conftest import Room, default_config
 
@@ -391,6 +391,12 @@ def test_objects_planned_against_a_wall_turn_their_back_to_it_as_often_as_in_the
     assert not any(back_to_wall(d, o, 0.1, math.radians(15))[0] for d, o in desks)  # by its side
     assert "desk" not in learn(turned) and learn(turned)["bed"] == 1.0
     assert learn([furnished(s).room_input() for s in range(4)]) == {}  # 8 nightstands, 4 of the rest
+    # wall-bound: the categories standing against a wall (any side) at least the share asked; the sideways desks too
+    bound = lambda rooms, share=0.95: learn_wall_bound(rooms, 0.1, math.radians(15), share, 10, cfg["floor_contact"])
+    assert bound([furnished(s).room_input() for s in range(12)]) == {"bed", "desk", "nightstand", "tv_stand"}
+    assert bound(turned) == {"bed", "desk", "nightstand", "tv_stand"}
+    assert bound([furnished(s).room_input() for s in range(4)]) == frozenset()  # 8 nightstands, 4 of the rest
+    assert bound([furnished(s).room_input() for s in range(12)], 0) == frozenset()
     # applied: a desk planned against the right wall, drawn with its side to the nearest wall, stands sideways; with
     # the rule its back is to the planned wall (the search's snap slides it flush)
     room, walls, pool, checker, cfg = setup_room(furnished(0))

@@ -8,6 +8,8 @@ import json
 import logging
 from dataclasses import dataclass
 
+import numpy as np
+
 from .. import tables
 from ..geometry.raycast import intersector_class
 from ..placement import scene_metrics
@@ -15,6 +17,7 @@ from ..placement.checks import Checker, checks_config
 from ..placement.plan import ScenePlan
 from ..placement.retrieval import ModelPool
 from ..placement.support import learn_support_floor
+from ..placement.walls import learn_wall_bound
 from .interface import Corpus, Scene
 
 log = logging.getLogger("planit.instantiate")
@@ -38,9 +41,14 @@ def load_context(config: dict, corpus: Corpus) -> Context:
     training = corpus.training()
     checks = checks_config(config)
     floor = learn_support_floor(training, checks, config["floor_contact"])
-    checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor)
+    snap = config["instantiate"]["snap"]
+    bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
+                             checks["wall_bound_share"], snap["centre_min_pairs"], config["floor_contact"])
+    checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor,
+                      bound)
     if floor:
         log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
+    log.info("%s: categories kept at their planned walls: %s", corpus.room_type, sorted(bound))
     objs = corpus.objects
     pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
     return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))

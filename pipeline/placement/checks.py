@@ -55,6 +55,7 @@ class Checker:
     intersector: type
     cfg: dict
     support_floor: dict = field(default_factory=dict)  # category -> learned lower min_support (placement/support.py)
+    wall_bound: frozenset = frozenset()  # categories whose planned wall adjacency is never broken (placement/walls.py)
 
     def min_support(self, category: str) -> float:
         """The share of its footprint an object of ``category`` must keep over its support."""
@@ -163,11 +164,20 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
     blame.discard(me)
     if cost > tolerance or (cost >= 1.0 and planned):
         return Verdict(False, f"violates its relations (cost {cost:.2f})", cost, blame)
+    if room.categories[k] in checker.wall_bound and leaves_wall(me, set(room.object_ids), planned, costs):
+        return Verdict(False, "leaves its planned wall", cost, blame)
     if checker.cfg["relations_first"]:
         hit = collision(room, k, related, checker)
         if hit is not None:
             return collides(room, hit)
     return Verdict(True, cost=cost, edge_costs=list(zip(planned, costs)), found=found)
+
+
+def leaves_wall(me: str, objects: set[str], planned: list[PlanEdge], costs: list[float]) -> bool:
+    """Whether object ``me`` breaks a planned "adjacent" edge from a wall (a source that is no object: openings
+    source no spatial edge)."""
+    return any(c > 0 for e, c in zip(planned, costs) if e.target == me and e.source not in objects
+               and e.edge_type == "spatial" and e.distance == "adjacent")
 
 
 def collides(room: RoomInput, hit: tuple[int, float]) -> Verdict:

@@ -13,11 +13,10 @@ from ..geometry.function import back_to_wall
 from ..room import RoomInput
 
 
-def learn_wall_backs(rooms: list[RoomInput], gap: float, angle: float, min_pairs: int,
-                     floor_contact: float) -> dict[str, float]:
-    """category -> the share of its training floor objects against a wall that have their back to a wall (only
-    categories with at least ``min_pairs`` such objects and a positive share)."""
-    against: dict[str, list[bool]] = {}
+def wall_stands(rooms: list[RoomInput], gap: float, angle: float, floor_contact: float) -> dict[str, list[int]]:
+    """category -> per training floor object, 0 (not against a wall), 1 (against one, another side to it) or 2
+    (against one, its back to it)."""
+    stands: dict[str, list[int]] = {}
     for room in rooms:
         b = room.boxes.reshape(-1, 7)
         floor = np.flatnonzero(on_floor(b, floor_contact))
@@ -25,7 +24,25 @@ def learn_wall_backs(rooms: list[RoomInput], gap: float, angle: float, min_pairs
             continue
         near = back_to_wall(b[floor], room.outline, gap, angle, ["rotational-4"] * len(floor))  # any side
         back = back_to_wall(b[floor], room.outline, gap, angle)
-        for k in np.flatnonzero(near):
-            against.setdefault(room.categories[floor[k]], []).append(bool(back[k]))
+        for k, stand in zip(floor, near.astype(int) + (near & back).astype(int)):
+            stands.setdefault(room.categories[k], []).append(int(stand))
+    return stands
+
+
+def learn_wall_backs(rooms: list[RoomInput], gap: float, angle: float, min_pairs: int,
+                     floor_contact: float) -> dict[str, float]:
+    """category -> the share of its training floor objects against a wall that have their back to a wall (only
+    categories with at least ``min_pairs`` such objects and a positive share)."""
+    against = {c: [s == 2 for s in v if s] for c, v in wall_stands(rooms, gap, angle, floor_contact).items()}
     shares = {c: round(float(np.mean(flags)), 3) for c, flags in sorted(against.items()) if len(flags) >= min_pairs}
     return {c: s for c, s in shares.items() if s > 0}
+
+
+def learn_wall_bound(rooms: list[RoomInput], gap: float, angle: float, share: float, min_pairs: int,
+                     floor_contact: float) -> frozenset[str]:
+    """The categories whose training floor objects stand against a wall at least ``share`` of the time (at least
+    ``min_pairs`` objects; ``share`` 0: none): the search never breaks such an object's planned wall adjacency."""
+    if share <= 0:
+        return frozenset()
+    stands = wall_stands(rooms, gap, angle, floor_contact)
+    return frozenset(c for c, v in stands.items() if len(v) >= min_pairs and np.mean(np.asarray(v) > 0) >= share)
