@@ -17,7 +17,7 @@ from pipeline.geometry.frames import to_local, to_world, turn_error, wrap
 from pipeline.geometry.function import REGIONS, back_to_wall, facing_angles, facing_each_other, regions
 from pipeline.geometry.raycast import intersector_class
 from pipeline.placement.checks import Checker
-from pipeline.placement.facing import AnchorFacing, learn_anchor_facing, learn_facing_partners
+from pipeline.placement.facing import AnchorFacing, learn_anchor_facing, learn_facing_partners, learn_partner_distances
 from pipeline.placement.layout import add_object, box_frame, wall_frame, walls_of, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import (
@@ -677,6 +677,41 @@ def test_objects_face_the_objects_and_partner_walls_the_training_rooms_objects_f
                                                       cfg["instantiate"], seed), "c")
     assert sum(down(ahead(turned, seed)) for seed in SEEDS) < len(SEEDS) - 2
     assert all(down(ahead(FacingPartner(turned, {("desk", "chair"): 1.0}, math.pi / 4, 16), seed)) for seed in SEEDS)
+
+
+class FarEnd:
+    """The relation bands, with all but a millionth of their mass beyond x = 5 m."""
+
+    def __init__(self, extract):
+        self.bands = RelationPrior(extract)
+
+    def density(self, room, walls, category, anchors, points):
+        return self.bands.density(room, walls, category, anchors, points) * np.where(points[:, 0] > 5.0, 1.0, 1e-6)
+
+
+def test_an_object_whose_draws_all_miss_its_partners_view_is_drawn_again_within_it_at_the_training_distance():
+    # learned: the hand-built chairs stand 0.70-0.85 m from the desk they face (centre to centre)
+    cfg = default_config()
+    apart = lambda q: learn_partner_distances([furnished(s).room_input() for s in range(12)], math.pi / 4, q,
+                                              cfg["floor_contact"])[("desk", "chair")]
+    assert 0.70 <= apart(0.0) <= apart(0.5) <= apart(1.0) <= 0.85
+    # applied: in a long, shallow room a chair planned against the top wall is drawn beyond x = 5 m, where the desk at
+    # the bottom wall's left end (facing up, its view reaching x = 3.4 m there) cannot see it, turned or not; the rule
+    # draws it again among the cells in the desk's view no nearer than the training pairs, and turns it to the desk
+    room, walls, pool, checker, cfg = setup_room(furnished(0), width=8.0, depth=3.0)
+    desk = given(room, pool, "desk", "desk", (1.0, 0.3), 0)
+    plan = plan_of("c", "chair", [PlanEdge(walls.ids[2], "c", "spatial", "front", "adjacent")])
+    far = Combined(FarEnd(cfg["extract"]), FaceAway())
+    chair = lambda proposer, seed: placed(instantiate(plan, desk, [0], proposer, Kit(pool, checker), cfg["instantiate"],
+                                                      seed), "c")
+    faces = lambda box: bool(facing_each_other(np.vstack([desk.boxes.reshape(-1, 7), box]), math.pi / 4)[0, 1])
+    assert not any(faces(chair(far, seed)) for seed in SEEDS)
+    for seed in SEEDS:
+        box = chair(FacingPartner(far, {("desk", "chair"): 1.0}, math.pi / 4, 16, {("desk", "chair"): 2.45}), seed)
+        assert faces(box) and box[0] < 3.4 and np.hypot(box[0] - 1.0, box[1] - 0.3) >= 2.45, (seed, box)
+    # no cell of its view that far from the desk: the draw stands as it was (no turn makes the desk see it)
+    alone = chair(FacingPartner(far, {("desk", "chair"): 1.0}, math.pi / 4, 16, {("desk", "chair"): 50.0}), 0)
+    assert alone[0] > 5.0 and not faces(alone)
 
 
 @pytest.mark.slow

@@ -164,6 +164,18 @@ def facing_each_other(boxes: np.ndarray, limit: float) -> np.ndarray:
     return out
 
 
+def in_front(boxes: np.ndarray, points: np.ndarray, limit: float) -> np.ndarray:
+    """``(n,)`` bool: some box of ``boxes (m, 7)`` has its front within ``limit`` rad of the direction from its centre
+    to ``points (n, 2)``: where a candidate centre stands for :func:`facing_each_other`'s second test (the television
+    stand's front turned towards the sofa), for a whole grid at once."""
+    b = np.asarray(boxes, float).reshape(-1, 7)
+    d = np.asarray(points, float).reshape(-1, 2)[:, None, :] - b[None, :, :2]  # (n, m, 2)
+    front = np.stack([-np.sin(b[:, 6]), np.cos(b[:, 6])], -1)[None]  # (1, m, 2)
+    cos = np.einsum("nmj,nmj->nm", d, front) / np.maximum(np.linalg.norm(d, axis=-1), 1e-12)
+    out: np.ndarray = (cos >= np.cos(limit)).any(axis=1)
+    return out
+
+
 def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_angle: float,
                  symmetry: ArrayLike | None = None) -> np.ndarray:
     """``(n,)`` bool: the object's back faces a wall of the floor ``outline (k, 2)`` (its back normal within

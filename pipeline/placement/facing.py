@@ -29,33 +29,46 @@ from ..room import RoomInput
 Pair = tuple[str, str]  # (partner category, object category)
 
 
-def facing_partner_flags(room: RoomInput, facing: float, floor_contact: float) -> dict[Pair, list[bool]]:
-    """(partner category, object category) -> per floor object of the category, whether it faces some floor object
-    of the partner category within ``facing`` rad (only categories the room holds both of on the floor)."""
+def facing_partner_distances(room: RoomInput, facing: float, floor_contact: float) -> dict[Pair, list[float]]:
+    """(partner category, object category) -> per floor object of the category, the centre distance (m) to the
+    nearest floor object of the partner category it faces within ``facing`` rad, inf where it faces none (only
+    categories the room holds both of on the floor)."""
     b = room.boxes.reshape(-1, 7)
     floor = np.flatnonzero(on_floor(b, floor_contact))
     cats = np.array([room.categories[k] for k in floor], object)
     faces = facing_each_other(b[floor], facing)  # (partner, object)
-    out: dict[Pair, list[bool]] = {}
+    apart = np.linalg.norm(b[floor, None, :2] - b[None, floor, :2], axis=-1)
+    out: dict[Pair, list[float]] = {}
     for partner in sorted(set(cats)):
-        rows = faces[cats == partner]
+        rows = np.where(faces[cats == partner], apart[cats == partner], np.inf)
         for k in range(len(floor)):
             if (cats == partner).sum() - (cats[k] == partner) > 0:
-                out.setdefault((partner, cats[k]), []).append(bool(rows[:, k].any()))
+                out.setdefault((partner, cats[k]), []).append(float(rows[:, k].min()))
     return out
 
 
 def learn_facing_partners(rooms: list[RoomInput], facing: float, min_pairs: int, min_share: float,
                           floor_contact: float) -> dict[Pair, float]:
     """(partner category, object category) -> the share of the training floor objects of the category that face a
-    partner (:func:`facing_partner_flags`), kept where at least ``min_pairs`` objects show it and the share is at least
-    ``min_share``."""
+    partner (:func:`facing_partner_distances`), kept where at least ``min_pairs`` objects show it and the share is at
+    least ``min_share``."""
     seen: dict[Pair, list[bool]] = {}
     for room in rooms:
-        for pair, flags in facing_partner_flags(room, facing, floor_contact).items():
-            seen.setdefault(pair, []).extend(flags)
+        for pair, apart in facing_partner_distances(room, facing, floor_contact).items():
+            seen.setdefault(pair, []).extend(np.isfinite(apart).tolist())
     shares = {pair: round(float(np.mean(f)), 3) for pair, f in sorted(seen.items()) if len(f) >= min_pairs}
     return {pair: s for pair, s in shares.items() if s >= min_share}
+
+
+def learn_partner_distances(rooms: list[RoomInput], facing: float, quantile: float,
+                            floor_contact: float) -> dict[Pair, float]:
+    """(partner category, object category) -> the ``quantile`` of the centre distances (m) between the training floor
+    objects that face a partner and that partner: how close a sofa stands to the television stand it faces."""
+    seen: dict[Pair, list[float]] = {}
+    for room in rooms:
+        for pair, apart in facing_partner_distances(room, facing, floor_contact).items():
+            seen.setdefault(pair, []).extend(d for d in apart if np.isfinite(d))
+    return {pair: round(float(np.quantile(d, quantile)), 3) for pair, d in sorted(seen.items()) if d}
 
 
 class AnchorFacing(NamedTuple):

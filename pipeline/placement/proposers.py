@@ -13,7 +13,7 @@ import numpy as np
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d, point_box
 from ..geometry.frames import to_local, to_world, turn_error, wrap
-from ..geometry.function import faces_wall, facing_angles, facing_each_other, facing_turn
+from ..geometry.function import faces_wall, facing_angles, facing_each_other, facing_turn, in_front
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
@@ -264,20 +264,23 @@ class FacingPartner:
     (:func:`~pipeline.geometry.function.facing_each_other`): up to ``tries`` poses are drawn and the first that faces
     one is kept; where none does, the first that does once turned to squarely face the side of the nearest partner its
     place lies beyond (:func:`~pipeline.geometry.function.facing_turn`; a turn drawn, as a wall back, goes first; never
-    turned away from a planned anchor it faced as drawn), else the first drawn. With no partner placed yet, a
+    turned away from a planned anchor it faced as drawn), else one drawn among the cells in a partner's view no nearer
+    than the training pairs stand (``near``: (partner, object) category -> m), else the first drawn. With no partner placed yet, a
     partner the plan puts against a wall later (:attr:`Request.ahead`: a sofa placed before the television stand the
     plan puts in front of it, or says nothing of) stands in as that wall: the object is drawn squarely facing the
     wall's segment (:func:`~pipeline.geometry.function.faces_wall`), so that the partner, back to the wall, faces it
     back. A placed partner the object has a planned edge to is the plan's; an object on a support has none."""
 
-    def __init__(self, base, shares: dict[tuple[str, str], float], facing: float, tries: int):
-        self.base, self.shares, self.facing, self.tries = base, shares, facing, tries
+    def __init__(self, base, shares: dict[tuple[str, str], float], facing: float, tries: int,
+                 near: dict[tuple[str, str], float] | None = None):
+        self.base, self.shares, self.facing, self.tries, self.near = base, shares, facing, tries, near or {}
 
     def pose(self, req: Request, rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
         first = self.base.pose(req, rng)
         if first is None or any(a.kind == SUPPORT for a in req.anchors):
             return first
         partners, share, boxes, wall = self._partners(req), 0.0, req.room.boxes.reshape(-1, 7), None
+        near = np.array([self.near.get((req.room.categories[o], req.category), 0.0) for o in partners])
         if len(partners):
             share = max(self.shares[(req.room.categories[o], req.category)] for o in partners)
             boxes = boxes[partners]
@@ -294,12 +297,28 @@ class FacingPartner:
             if drawn is None:
                 break
             xy, yaw = drawn
-            if self._faces(req, boxes, xy, yaw, wall):
+            if self._faces(req, boxes, xy, yaw, wall, near):
                 return drawn
             turn = facing_turn(boxes[np.argmin(np.linalg.norm(boxes[:, :2] - xy, axis=1))], xy)
-            if turned is None and self._faces(req, boxes, xy, turn, wall) and self._keeps(req, xy, yaw, turn):
+            if turned is None and self._faces(req, boxes, xy, turn, wall, near) and self._keeps(req, xy, yaw, turn):
                 turned = (xy, turn)
-        return turned or first
+        return turned or (self._in_view(req, boxes, near, rng) if wall is None else None) or first
+
+    def _in_view(self, req: Request, partners: np.ndarray, near: np.ndarray,
+                 rng: np.random.Generator) -> tuple[np.ndarray, float] | None:
+        """A pose drawn from the base proposer among the cells within a placed partner's facing cone and no nearer
+        to any partner than the training pairs stand (``near (m,)`` m), turned to face the nearest partner's side
+        (None where no such cell has mass or the turned pose faces none): a sofa whose draws all stood beside the
+        television's view, along its own wall."""
+        apart = np.linalg.norm(req.grid.points[:, None] - partners[None, :, :2], axis=-1)  # (cells, partners)
+        seen = req.mask & in_front(partners, req.grid.points, self.facing) & (apart >= near).all(axis=1)
+        drawn = self.base.pose(replace(req, mask=seen), rng) if seen.any() else None
+        if drawn is None:
+            return None
+        xy, yaw = drawn
+        turn = facing_turn(partners[np.argmin(np.linalg.norm(partners[:, :2] - xy, axis=1))], xy)
+        faces = self._faces(req, partners, xy, turn, None, near) and self._keeps(req, xy, yaw, turn)
+        return (xy, turn) if faces else None
 
     def _partners(self, req: Request) -> np.ndarray:
         """Indices of the placed objects of a partner category the plan gives the object no edge to."""
@@ -317,15 +336,18 @@ class FacingPartner:
         angles = facing_angles(boxes)[:-2, -2:]  # (planned, drawn | turned)
         return bool(np.all((angles[:, 0] > self.facing) | (angles[:, 1] <= self.facing)))
 
-    def _faces(self, req: Request, partners: np.ndarray, xy: np.ndarray, yaw: float, wall: int | None) -> bool:
-        """A pose at ``xy`` turned ``yaw`` faces one of ``partners (m, 7)``: each within ``facing`` of the other; or,
+    def _faces(self, req: Request, partners: np.ndarray, xy: np.ndarray, yaw: float, wall: int | None,
+               near: np.ndarray) -> bool:
+        """A pose at ``xy`` turned ``yaw`` faces one of ``partners (m, 7)``: each within ``facing`` of the other, no
+        nearer than ``near (m,)`` m (how near the training pairs stand); or,
         standing in for a partner placed later against ``wall``, faces that wall squarely and meets it
         (:func:`~pipeline.geometry.function.faces_wall`: what stands there with its back to it faces the pose)."""
         if wall is not None:
             walls = req.walls
             return bool(faces_wall(xy, yaw, walls.a[wall], walls.b[wall], walls.normal[wall], self.facing)[0])
         boxes = np.vstack([partners, point_box(xy, yaw)])
-        return bool(facing_each_other(boxes, self.facing)[:-1, -1].any())
+        far = np.linalg.norm(partners[:, :2] - xy, axis=1) >= near
+        return bool((facing_each_other(boxes, self.facing)[:-1, -1] & far).any())
 
     @staticmethod
     def _wall_box(req: Request, w: int) -> np.ndarray:

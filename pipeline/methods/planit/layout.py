@@ -16,7 +16,7 @@ from ...errors import InputError
 from ...learning import checkpoint
 from ...log import progress
 from ...placement import order, proposers
-from ...placement.facing import learn_anchor_facing, learn_facing_partners
+from ...placement.facing import learn_anchor_facing, learn_facing_partners, learn_partner_distances
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
@@ -41,12 +41,14 @@ class PoseRules:
     (partner, object) category the share of objects facing a partner (:func:`~pipeline.placement.facing.
     learn_facing_partners`) and of objects near an anchor facing it (:func:`~pipeline.placement.facing.
     learn_anchor_facing`); per (support, object) category the quarter turns and residual turns of objects on a
-    support (:func:`~pipeline.placement.turns.learn_support_turns`)."""
+    support (:func:`~pipeline.placement.turns.learn_support_turns`); per (partner, object) category how near the
+    objects facing a partner stand to it (:func:`~pipeline.placement.facing.learn_partner_distances`)."""
     centring: dict = field(default_factory=dict)
     wall_backs: dict = field(default_factory=dict)
     partners: dict = field(default_factory=dict)
     anchor_facing: dict = field(default_factory=dict)
     support_turns: dict = field(default_factory=dict)
+    partner_near: dict = field(default_factory=dict)
 
 
 def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRules | None = None):
@@ -68,7 +70,7 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRul
     if rules.wall_backs:
         base = proposers.BackToWall(base, rules.wall_backs)
     if rules.partners:
-        base = proposers.FacingPartner(base, rules.partners, facing, cfg["snap"]["partner_tries"])
+        base = proposers.FacingPartner(base, rules.partners, facing, cfg["snap"]["partner_tries"], rules.partner_near)
     if rules.support_turns:
         base = proposers.TurnedOnSupport(base, rules.support_turns)
     if rules.centring:
@@ -93,7 +95,8 @@ def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
         learn_anchor_facing(training, snap["face_anchor_gap"], facing, snap["centre_min_pairs"], snap["facing_min_share"],
                             floor) if snap["face_anchor_gap"] > 0 else {},
         learn_support_turns(training, tolerance, floor, snap["centre_min_pairs"], snap["support_turn_min_share"])
-        if snap["support_turns"] else {})
+        if snap["support_turns"] else {},
+        learn_partner_distances(training, facing, snap["partner_near_quantile"], floor) if snap["partner_tries"] else {})
     named = lambda rule: {"/".join(key): (tuple(v[:2]) if isinstance(v, tuple) else v) for key, v in rule.items()}
     log.info("%s: pose rules from the training rooms: centre lines and back edges %s; back to the wall %s; facing "
              "partners %s; facing anchors %s; quarter turns on supports %s", corpus.room_type, named(rules.centring),
