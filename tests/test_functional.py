@@ -11,7 +11,7 @@ import shapely
 
 from pipeline.evaluation import functional, intervals, perturb, power
 from pipeline.geometry.boxes import footprint_corners
-from pipeline.geometry.function import REGIONS, back_to_wall, faces_wall, facing_angles, footprint_gaps, plan_gaps, regions
+from pipeline.geometry.function import REGIONS, back_to_wall, faces_wall, facing_angles, footprint_gaps, in_front, plan_gaps, regions
 
 from conftest import Room, default_config
 
@@ -62,6 +62,22 @@ def test_a_pose_faces_a_wall_only_squarely_and_within_the_walls_extent():
     yaw = np.radians([180.0, 150.0, 90.0, 180.0, 180.0, 150.0])  # front -y, or turned 30 degrees toward -x; 90: -x
     assert faces_wall(xy, yaw, a, b, normal, limit).tolist() == [True, True, False, False, False, True]
     assert not faces_wall(xy[:1], np.radians(120.0), a, b, normal, limit)[0]  # 60 degrees off square
+
+
+def test_in_front_is_facing_each_others_view_test_for_a_whole_grid():
+    # a stand at the origin facing +y (yaw 0): a point is in its view when the stand's front lies within 45 degrees of
+    # the direction to it (43.5 and 46.4 degrees at x = 1.9 and 2.1); a second stand at (5, 0) facing -x sees more;
+    # the answer is facing_each_other's second test, a zero-extent box standing at the point
+    stands = np.array([[0.0, 0.0, 0.3, 0.6, 0.2, 0.3, 0.0], [5.0, 0.0, 0.3, 0.6, 0.2, 0.3, np.pi / 2]])
+    points = np.array([[0.0, 2.0], [1.9, 2.0], [2.1, 2.0], [0.0, -1.0], [3.0, 0.5], [3.0, 2.5], [5.0, 3.0]])
+    limit = np.radians(45)
+    assert in_front(stands[:1], points, limit).tolist() == [True, True, False, False, False, False, False]
+    assert in_front(stands, points, limit).tolist() == [True, True, True, True, True, False, False]
+    for k, p in enumerate(points):
+        centres = np.vstack([stands, [p[0], p[1], 0.0, 0.0, 0.0, 0.0, 0.0]])
+        centres[:, 3:6] = 0.0
+        seen = facing_angles(centres).T[:2, 2] <= limit  # stand i's front within the limit of the point's direction
+        assert bool(seen.any()) == in_front(stands, p[None], limit)[0], k
 
 
 def test_the_predicates_place_a_nightstand_at_the_head_and_a_chair_facing_its_desk():
