@@ -32,7 +32,9 @@ class Context:
     mean_area: dict
 
 
-def load_context(config: dict, corpus: Corpus) -> Context:
+def load_context(config: dict, corpus: Corpus, wall_bound_share: float | None = None) -> Context:
+    """The room type's model pool, checker (with the support shares and wall-bound categories learned from the
+    training rooms; ``wall_bound_share``: a variant's own, else ``instantiate.wall_bound_share``) and mean areas."""
     sym_rows = tables.read(corpus.symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
     sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
     sizes = tables.read(corpus.category_sizes, "category_sizes").to_pandas()
@@ -42,8 +44,9 @@ def load_context(config: dict, corpus: Corpus) -> Context:
     checks = checks_config(config)
     floor = learn_support_floor(training, checks, config["floor_contact"])
     snap = config["instantiate"]["snap"]
-    bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
-                             checks["wall_bound_share"], snap["centre_min_pairs"], config["floor_contact"])
+    share = config["instantiate"]["wall_bound_share"] if wall_bound_share is None else wall_bound_share
+    bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]), share,
+                             snap["centre_min_pairs"], config["floor_contact"])
     checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor,
                       bound)
     if floor:

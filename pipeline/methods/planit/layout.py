@@ -177,7 +177,7 @@ class PlanitLayout:
     def generate(self, task: Task) -> Iterator[Scene]:
         torch.set_num_threads(task.threads)
         saved = checkpoint.load(task.model, checkpoint_kind(self.variant["location"]))
-        ctx = load_context(self.config, task.corpus)
+        ctx = load_context(self.config, task.corpus, self.settings["wall_bound_share"])
         count = task.count or scene_count(self.config["instantiate"], self.variant)
         draws = self.settings["graph_draws"] if self.variant["graphs"] == "sampled" else 1
         plans = select_plans(self.config, self.variant, task.corpus, *task.graphs, count * draws)
