@@ -32,9 +32,10 @@ class Context:
     mean_area: dict
 
 
-def load_context(config: dict, corpus: Corpus, wall_bound_share: float | None = None) -> Context:
-    """The room type's model pool, checker (with the support shares and wall-bound categories learned from the
-    training rooms; ``wall_bound_share``: a variant's own, else ``instantiate.wall_bound_share``) and mean areas."""
+def load_context(config: dict, corpus: Corpus, wall_bound_share: float = 0.0) -> Context:
+    """The room type's model pool, checker (with the support shares learned from the training rooms and, for PlanIT's
+    search, the categories it keeps at their planned walls: ``wall_bound_share``, its ``instantiate.wall_bound_share``;
+    0: none, for the methods with placements of their own) and mean areas."""
     sym_rows = tables.read(corpus.symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
     sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
     sizes = tables.read(corpus.category_sizes, "category_sizes").to_pandas()
@@ -43,15 +44,17 @@ def load_context(config: dict, corpus: Corpus, wall_bound_share: float | None = 
     training = corpus.training()
     checks = checks_config(config)
     floor = learn_support_floor(training, checks, config["floor_contact"])
-    snap = config["instantiate"]["snap"]
-    share = config["instantiate"]["wall_bound_share"] if wall_bound_share is None else wall_bound_share
-    bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]), share,
-                             snap["centre_min_pairs"], config["floor_contact"])
+    bound: frozenset[str] = frozenset()
+    if wall_bound_share > 0:
+        snap = config["instantiate"]["snap"]
+        bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
+                                 wall_bound_share, snap["centre_min_pairs"], config["floor_contact"])
     checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor,
                       bound)
     if floor:
         log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
-    log.info("%s: categories kept at their planned walls: %s", corpus.room_type, sorted(bound))
+    if bound:
+        log.info("%s: categories kept at their planned walls: %s", corpus.room_type, sorted(bound))
     objs = corpus.objects
     pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
     return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))

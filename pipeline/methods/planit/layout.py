@@ -217,7 +217,7 @@ class CompleteRoom:
         if not 0 <= self.keep <= len(plan.ids):
             raise InputError(f"keep: {self.keep}, but room {self.room} has {len(plan.ids)} objects")
         saved = checkpoint.load(task.model, KIND)
-        ctx = load_context(self.config, task.corpus)
+        ctx = load_context(self.config, task.corpus, self.config["instantiate"]["wall_bound_share"])
         proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"],
                                  pose_rules(self.config, task.corpus))
         seed = seed_of(self.config["seed"], "complete", plan.scene_id)
