@@ -132,7 +132,7 @@ def main() -> None:
         cfg["instantiate"]["density_cache"] = args.density_cache
     saved = checkpoint.load(Path("results/placement") / args.room_type / args.location / "model.pt",
                             instantiate.checkpoint_kind(args.location))
-    ctx = load_context(cfg, corpus_of(cfg, args.room_type))
+    ctx = load_context(cfg, corpus_of(cfg, args.room_type), cfg["instantiate"]["wall_bound_share"])  # as PlanIT's search
     if args.no_confirm:
         ctx.checker.cfg["confirm"] = None
     variant = {**cfg["instantiate"]["variants"]["planit"], "location": args.location, "graphs": args.graphs}

@@ -58,7 +58,7 @@ def main() -> None:
     location = {"planit": "cfcn", "planit_prior": "prior"}[args.method]
     saved = checkpoint.load(Path("results/placement") / args.room_type / location / "model.pt",
                             inst.checkpoint_kind(location))
-    ctx = load_context(cfg, corpus_of(cfg, args.room_type))
+    ctx = load_context(cfg, corpus_of(cfg, args.room_type), cfg["instantiate"]["wall_bound_share"])  # as PlanIT's search
     variant = {**cfg["instantiate"]["variants"]["planit"], "location": location}
     graphs = Path("results/graph_model") / args.room_type / "planit" / "sampled"
     plans = inst.select_plans(cfg, variant, ctx.corpus, graphs / "nodes.parquet", graphs / "edges.parquet", 200)
