@@ -21,6 +21,7 @@ from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Combined, FaceAway, RelationPrior
 from pipeline.placement.retrieval import ModelPool, place
 from pipeline.placement.search import Kit, instantiate
+from pipeline.placement.walls import unspanned
 from pipeline.stage import Files
 
 from conftest import Room, default_config
@@ -144,6 +145,47 @@ def test_a_wall_bound_category_breaks_its_other_relations_not_its_planned_wall()
             broken[bound, seed] = {b["source"] for b in out.relaxed[0]["broken"]}
     assert sum(broken[frozenset(), s] == {"wall_2"} for s in range(4)) >= 2
     assert all(broken[frozenset({"wardrobe", "desk"}), s] == {"w"} for s in range(4))
+
+
+def test_facing_walls_are_spanned_by_a_footprint_turned_any_way_or_not_at_all():
+    """A 1.2 x 0.6 m footprint reaches across 1.3 m only turned (its diagonal is 1.34 m, and extraction's adjacent gap
+    at that diagonal 0.05 m at each face), not across 1.5 m; it is too wide for 0.5 m; two walls at right angles, or
+    one wall, are no pair."""
+    distance = default_config()["extract"]["distance"]
+    for width, spanned in ((1.3, True), (1.2, True), (0.62, True), (1.5, False), (0.5, False)):
+        walls = walls_of(Room([(0, 0), (width, 0), (width, 3.0), (0, 3.0)]).room_input())
+        hit = unspanned(walls, ["wall_1", "wall_3", "wall_0"], np.array([[0.6, 0.3]]), distance, 0.02)
+        assert (hit is None) == spanned, (width, hit)
+        if not spanned:
+            assert hit[:2] == ("wall_1", "wall_3") and hit[2] == pytest.approx(width)
+    walls = walls_of(Room([(0, 0), (1.5, 0), (1.5, 3.0), (0, 3.0)]).room_input())
+    assert unspanned(walls, ["wall_0", "wall_1"], np.array([[0.6, 0.3]]), distance, 0.02) is None
+    assert unspanned(walls, ["wall_1", "wall_3"], np.array([[0.6, 0.3], [0.8, 0.3]]), distance, 0.02) is None  # 1.6 m fits
+
+
+@pytest.mark.parametrize("mode", ["fail", "drop"])
+def test_a_wall_bound_object_planned_between_walls_no_instance_spans_is_refused_before_any_candidate(mode):
+    """The graph model planned bathtubs against both walls of a 3 m wide bathroom (an alcove it learned from narrower
+    rooms); a wall-bound tub never breaks either edge, so the search spent every backtrack and restart on it. The
+    1.0 m wardrobe against the two long walls of a 4 x 3.5 m room fails at once with its cause (or is left out), and
+    in a room 1.05 m wide the same plan is placed with both edges."""
+    plan = ScenePlan("s5", "r0", "office", ["w"], ["wardrobe"], ["left-right"], [1], [None], ["none"],
+                     [PlanEdge("wall_1", "w", "spatial", "front", "adjacent"),
+                      PlanEdge("wall_3", "w", "spatial", "front", "adjacent")])
+    room, walls, pool, checker, ic = setup(["wardrobe"], on_exhausted=mode)
+    checker = replace(checker, wall_bound=frozenset({"wardrobe"}))
+    out = instantiate(plan, room, [0], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 0)
+    assert out.rejections == 0 and out.attempts == 1 and out.room.object_ids == []
+    if mode == "fail":
+        assert out.status == "failed" and out.reason == ("unsatisfiable plan: w (wardrobe) planned against wall_1 and "
+                                                         "wall_3, 4.00 m apart, which no instance spans")
+    else:
+        assert out.status == "partial" and [(d["id"], d["cause"]) for d in out.drops] == [("w", "no_span")]
+    room, walls, pool, checker, ic = setup(["wardrobe"], ((0, 0), (1.05, 0), (1.05, 3.0), (0, 3.0)), on_exhausted=mode)
+    checker = replace(checker, wall_bound=frozenset({"wardrobe"}))
+    fits = instantiate(plan, room, [0], Combined(RelationPrior(EXTRACT), FaceAway()), Kit(pool, checker), ic, 0)
+    assert fits.status == "placed" and fits.relaxed == [], fits.reason
+    assert scene_metrics.consistency(plan, fits.room, walls.ids, checker)["consistency"] == 1.0
 
 
 NARROW = ((0, 0), (1.4, 0), (1.4, 3.0), (0, 3.0))

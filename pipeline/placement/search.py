@@ -44,6 +44,7 @@ from .order import chains
 from .plan import ScenePlan
 from .proposers import Grid, RelationPrior, Request, gap_thresholds
 from .retrieval import ModelPool, place
+from .walls import unspanned
 
 log = logging.getLogger("planit.instantiate")
 
@@ -76,7 +77,7 @@ class Outcome:
 
 
 DROP_CAUSES = {"no_place": "no place once the backtrack budget was spent", "no_model": "no training instance",
-               "support_dropped": "support dropped"}
+               "no_span": "planned against two facing walls no instance spans", "support_dropped": "support dropped"}
 SCORED = ("placed", "partial")  # the statuses of scenes that hold a room to score (a partial one lacks what it dropped)
 
 
@@ -421,13 +422,16 @@ class Search:
         if missing and self.cfg["on_exhausted"] == "fail":  # no model to place: fail before placing anything
             k = next(k for k in self.order if k in missing)
             return f"no training instance of category '{self.plan.categories[k]}' for {self.plan.ids[k]}"
+        unspannable = self.unspannable(missing)
+        if unspannable and self.cfg["on_exhausted"] == "fail":  # a wall-bound object no instance fits: fail at once
+            return "unsatisfiable plan: " + unspannable[next(k for k in self.order if k in unspannable)]
         i = 0
         while i < len(self.order):
             if time.perf_counter() > deadline:
                 return f"time budget ({self.cfg['time_budget']} s) spent at object {i + 1} of {len(self.order)}"
             k = self.order[i]
-            if k in missing or self.plan.parent[k] in self.dropped:  # no model, or its support was left out
-                self.drop(k, "no_model" if k in missing else "support_dropped")
+            if k in missing or k in unspannable or self.plan.parent[k] in self.dropped:  # or its support was left out
+                self.drop(k, "no_model" if k in missing else "no_span" if k in unspannable else "support_dropped")
                 i += 1
                 continue
             culprits = self.try_place(i)
@@ -448,6 +452,24 @@ class Search:
                 return self.exhausted_reason(k)
             i = self.backtrack(i, culprits)
         return ""
+
+    def unspannable(self, missing: set[int]) -> dict[int, str]:
+        """Objects of wall-bound categories (which never break a planned wall adjacency) planned adjacent to two facing
+        walls that no training instance of their category can span (:func:`~pipeline.placement.walls.unspanned`):
+        plan index -> why. The graph model plans a bathtub between the walls of the alcove it learned in a room 3 m
+        wide; the search would spend every backtrack and restart on it."""
+        out = {}
+        for k in self.order:
+            v, cat = self.plan.ids[k], self.plan.categories[k]
+            if k in missing or cat not in self.checker.wall_bound:
+                continue
+            planned = [e.source for e in self.plan.edges if e.target == v and e.edge_type == "spatial"
+                       and e.distance == "adjacent" and e.source in self.walls.ids]
+            hit = unspanned(self.walls, planned, np.array([i.half[:2] for i in self.pool.by_cat[cat]]),
+                            self.checker.extract_cfg["distance"], self.checker.cfg["outside"])
+            if hit is not None:
+                out[k] = f"{v} ({cat}) planned against {hit[0]} and {hit[1]}, {hit[2]:.2f} m apart, which no instance spans"
+        return out
 
     def exhausted_reason(self, k: int) -> str:
         """Why a scene failed when its backtrack budget ran out: the object with no place and the check that refused

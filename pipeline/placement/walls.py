@@ -6,11 +6,15 @@ wall (some side within ``gap`` m of it, turned within ``angle`` rad) whose back 
 evaluation's own predicate (:func:`~pipeline.geometry.function.back_to_wall`)."""
 from __future__ import annotations
 
+from itertools import combinations
+
 import numpy as np
 
-from ..geometry.boxes import on_floor
+from ..geometry.boxes import diagonal_2d, on_floor
 from ..geometry.function import back_to_wall
-from ..room import RoomInput
+from ..room import RoomInput, Walls
+
+PARALLEL_COS = 0.999  # two walls whose inner normals' dot product is below minus this face each other (2.6 degrees)
 
 
 def wall_stands(rooms: list[RoomInput], gap: float, angle: float, floor_contact: float) -> dict[str, list[int]]:
@@ -46,3 +50,24 @@ def learn_wall_bound(rooms: list[RoomInput], gap: float, angle: float, share: fl
         return frozenset()
     stands = wall_stands(rooms, gap, angle, floor_contact)
     return frozenset(c for c, v in stands.items() if len(v) >= min_pairs and np.mean(np.asarray(v) > 0) >= share)
+
+
+def unspanned(walls: Walls, wall_ids: list[str], halves: np.ndarray, distance: dict,
+              margin: float) -> tuple[str, str, float] | None:
+    """Two of ``wall_ids`` that face each other too far apart (or too near) for any footprint of half extents ``halves
+    (k, 2)`` to be adjacent to both, turned any way: its extent across them lies between its smaller side and its
+    diagonal, and must reach within extraction's adjacent gap (``distance``: ``extract.distance``) of each face without
+    crossing them by more than ``margin`` m each. Returns (wall, wall, distance m) of the first such pair, else None:
+    a wall-bound object planned so fails whatever the search draws."""
+    halves = np.asarray(halves, float).reshape(-1, 2)
+    longest = diagonal_2d(halves[:, 0], halves[:, 1])
+    shortest = 2 * halves.min(1)
+    adjacent = np.minimum(distance["adjacent_abs"], distance["adjacent_rel"] * longest)
+    index = [walls.ids.index(w) for w in wall_ids if w in walls.ids]
+    for i, j in combinations(index, 2):
+        if walls.normal[i] @ walls.normal[j] > -PARALLEL_COS:
+            continue
+        apart = float((walls.a[j] - walls.a[i]) @ walls.normal[i])
+        if not ((longest >= apart - 2 * adjacent) & (shortest <= apart + 2 * margin)).any():
+            return walls.ids[i], walls.ids[j], apart
+    return None
