@@ -56,6 +56,7 @@ class Checker:
     cfg: dict
     support_floor: dict = field(default_factory=dict)  # category -> learned lower min_support (placement/support.py)
     wall_bound: frozenset = frozenset()  # categories whose planned wall adjacency is never broken (placement/walls.py)
+    weighted: bool = False  # an object's relation cost weighs each edge by its plan weight (instantiate.weighted_relations)
 
     def min_support(self, category: str) -> float:
         """The share of its footprint an object of ``category`` must keep over its support."""
@@ -129,15 +130,17 @@ def blocks_door(room: RoomInput, corners: np.ndarray, depth: float) -> bool:
 
 def relation_cost(room: RoomInput, planned: list[PlanEdge], checker: Checker) -> tuple[float, set[str], list[float], dict]:
     """Mean cost of ``planned`` edges (each between the new object and a node already in the room) on the room's
-    extracted graph, the objects at the other end of the edges not found exactly, each edge's cost, and the extracted
-    edges (:func:`found_edges`)."""
+    extracted graph (weighted by the edges' plan weights, adjacent 3 : proximal 2 : distant 1, when
+    ``checker.weighted``; PlanIT splits it evenly), the objects at the other end of the edges not found exactly, each
+    edge's cost, and the extracted edges (:func:`found_edges`)."""
     if not planned:
         return 0.0, set(), [], {}
     found = found_edges(checker.extract(room, anchors={e.source for e in planned}).edges)
     costs = [edge_cost(e, found) for e in planned]
     objects = set(room.object_ids)
     blame = {n for e, c in zip(planned, costs) if c > 0 for n in (e.source, e.target) if n in objects}
-    return float(np.mean(costs)), blame, costs, found
+    weights = [e.weight if checker.weighted else 1.0 for e in planned]
+    return float(np.average(costs, weights=weights)), blame, costs, found
 
 
 def check(room: RoomInput, k: int, parent: int | None, children: set[int], planned: list[PlanEdge],

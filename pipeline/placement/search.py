@@ -157,7 +157,8 @@ class Search:
     def __init__(self, plan: ScenePlan, room: RoomInput, order: list[int], proposer: Proposer, kit: Kit, cfg: dict,
                  rng: np.random.Generator):
         self.plan, self.walls, self.order = plan, walls_of(room), order
-        self.proposer, self.pool, self.checker, self.cfg, self.rng = proposer, kit.pool, kit.checker, cfg, rng
+        self.proposer, self.pool, self.cfg, self.rng = proposer, kit.pool, cfg, rng
+        self.checker = replace(kit.checker, weighted=cfg["weighted_relations"])
         self.fixed = len(room.object_ids)  # objects given (completion) are never moved
         self.room = room
         self.grid = Grid(room.outline, cfg["grid_mpp"])
