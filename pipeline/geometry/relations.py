@@ -17,6 +17,14 @@ DISTANCES = ("adjacent", "proximal", "distant")
 T = TypeVar("T")
 
 
+def distance_thresholds(max_diag: ArrayLike, cfg: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+    """The largest gaps (m) labelled adjacent and proximal (:func:`distance_labels`) between objects whose larger
+    footprint diagonal is ``max_diag`` (scalar or array; the result broadcasts alike)."""
+    max_diag = np.asarray(max_diag, float)
+    return (np.minimum(cfg["adjacent_abs"], cfg["adjacent_rel"] * max_diag),
+            np.maximum(cfg["proximal_abs"], cfg["proximal_rel"] * max_diag))
+
+
 def distance_labels(gap: ArrayLike, max_diag: ArrayLike, cfg: Mapping[str, Any]) -> np.ndarray:
     """adjacent / proximal / distant for gaps (m) between objects whose larger footprint diagonal is ``max_diag``.
 
@@ -24,8 +32,7 @@ def distance_labels(gap: ArrayLike, max_diag: ArrayLike, cfg: Mapping[str, Any])
     proximal_rel * max_diag); distant otherwise (paper §4.3).
     """
     gap, max_diag = np.broadcast_arrays(np.asarray(gap, float), np.asarray(max_diag, float))
-    adj = np.minimum(cfg["adjacent_abs"], cfg["adjacent_rel"] * max_diag)
-    prox = np.maximum(cfg["proximal_abs"], cfg["proximal_rel"] * max_diag)
+    adj, prox = distance_thresholds(max_diag, cfg)
     return np.where(gap <= adj, "adjacent", np.where(gap <= prox, "proximal", "distant"))
 
 

@@ -15,6 +15,7 @@ from ..geometry.boxes import SIDES, diagonal_2d, point_box
 from ..geometry.frames import to_local, to_world, turn_error, wrap
 from ..geometry.function import faces_wall, facing_angles, facing_each_other, facing_turn, in_front
 from ..geometry.polygon import nearest_segment
+from ..geometry.relations import distance_thresholds
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .facing import AnchorFacing
@@ -111,8 +112,8 @@ def gap_thresholds(a: Anchor, room: RoomInput, walls: Walls, extract: dict) -> t
     the two (a wall's is the object's)."""
     anchor_diag = 0.0 if a.wall is not None else float(diagonal_2d(*room.boxes[a.obj, 3:5]))
     diag = max(anchor_diag, float(diagonal_2d(*a.target_half)))
-    d = extract["distance"]
-    return min(d["adjacent_abs"], d["adjacent_rel"] * diag), max(d["proximal_abs"], d["proximal_rel"] * diag)
+    adj, prox = distance_thresholds(diag, extract["distance"])
+    return float(adj), float(prox)
 
 
 def band_limits(a: Anchor, room: RoomInput, walls: Walls, extract: dict, slack: float):
