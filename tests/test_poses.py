@@ -567,6 +567,47 @@ def test_an_object_planned_in_front_of_an_anchor_it_faces_takes_the_facing_pairs
     assert max(abs(across(c)) for c in chairs(both)) < 1e-9
 
 
+class _Drawn:
+    """A base proposer that always draws ``pose`` (xy, yaw rad)."""
+
+    def __init__(self, xy, yaw: float):
+        self.xy, self.yaw = np.asarray(xy, float), yaw
+
+    def pose(self, req, rng):
+        return self.xy.copy(), self.yaw
+
+
+def test_centring_never_moves_an_object_off_another_planned_edges_place():
+    # a table (a desk here) with a chair seated behind it; a second chair planned in front of the table and right,
+    # distant, of the first: the chair/chair rule (every training pair on one line, across and along) would move it
+    # to the first chair's depth, behind the table; the table's edge holds it along that axis, so it stays in front.
+    # The facing rule likewise leaves the depth of a chair planned in front of the table, facing a chair across it.
+    from pipeline.placement.anchors import anchors_of
+    from pipeline.placement.proposers import Grid, Request
+
+    room, walls, pool, _, _ = setup_room(furnished(0))
+    table = given(given(room, pool, "desk", "table", (2.2, 2.3), 0), pool, "chair", "c1", (2.2, 1.7), 0)
+    plan = plan_of("c2", "chair", [PlanEdge("table", "c2", "spatial", "front", "proximal"),
+                                   PlanEdge("c1", "c2", "spatial", "right", "distant")])
+    anchors = anchors_of("c2", plan, table, walls, {}, (0.25, 0.25))
+    req = Request(table, walls, "chair", "left-right", anchors, Grid(table.outline, 0.1), np.ones(1, bool))
+    drawn = _Drawn((3.4, 2.9), math.pi)  # in front of the table, facing it
+    rules = {("chair", "chair", "spatial"): CentreLine(1.0, 1.0)}
+    xy, _ = Centred(drawn, rules).pose(req, np.random.default_rng(0))
+    assert np.allclose(xy, [3.4, 2.9])
+    alone = Request(table, walls, "chair", "left-right", [a for a in anchors if a.node == "c1"],
+                    Grid(table.outline, 0.1), np.ones(1, bool))  # without the table's edge the rule applies
+    assert np.allclose(Centred(drawn, rules).pose(alone, np.random.default_rng(0))[0], [3.4, 1.7])
+    # facing: c1 turned to face c2's drawn place; c2 planned only in front of the table
+    facing = given(given(room, pool, "desk", "table", (2.2, 2.3), 0), pool, "chair", "c1", (2.6, 2.9), -math.degrees(math.pi / 2))
+    front = plan_of("c2", "chair", [PlanEdge("table", "c2", "spatial", "front", "proximal")])
+    req = Request(facing, walls, "chair", "left-right", anchors_of("c2", front, facing, walls, {}, (0.25, 0.25)),
+                  Grid(facing.outline, 0.1), np.ones(1, bool))
+    turned = _Drawn((3.4, 3.1), math.pi / 2)  # facing c1 (along -x), which faces it back
+    xy, _ = Centred(turned, {("chair", "chair", "facing"): CentreLine(1.0, 0.0)}).pose(req, np.random.default_rng(0))
+    assert np.allclose(xy, [3.4, 3.1])
+
+
 def _chairs_turned(rooms: list[Room], every: int) -> list[Room]:
     """``rooms`` with the chair of every ``every``-th room turned a quarter turn (its side to its desk)."""
     for r in rooms[::every]:

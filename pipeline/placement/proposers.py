@@ -24,6 +24,7 @@ from .support import EDGES, OFF_EDGE, CentreLine, EdgeRule, half_depth_on
 from .turns import QUARTER, SupportTurn
 
 WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
+HELD_COS = np.cos(np.pi / 4)  # an axis within 45 degrees of one a planned edge holds the object along is that axis
 
 
 @dataclass
@@ -407,6 +408,29 @@ class Masked(DensityProposer):
         return self.base.orientation(*args)
 
 
+def axis_of(yaw: float, direction: str) -> np.ndarray:
+    """The world unit axis ``(2,)`` along which a frame turned ``yaw`` (rad) measures ``direction``: its local y for
+    ``front``/``back``, its local x for ``left``/``right``."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.array([-s, c]) if direction in ("front", "back") else np.array([c, s])
+
+
+def held_axes(anchors: list[Anchor], yaw: float) -> np.ndarray:
+    """``(n, 2)`` world axes along which the object's planned spatial edges hold it: the axis of each edge's direction
+    in its frame (the anchor's; the drawn turn ``yaw`` for a reverse edge, whose direction is in the object's own
+    frame). A wall's edge holds the object at its distance from the wall."""
+    axes = [axis_of(yaw if a.reverse else a.frame.yaw, a.direction) for a in anchors
+            if a.kind != SUPPORT and a.direction is not None]
+    return np.array(axes).reshape(-1, 2)
+
+
+def unheld(share: np.ndarray, yaw: float, held: np.ndarray) -> np.ndarray:
+    """``share (2,)`` (of moving a place across and along a frame turned ``yaw``) with each component zeroed whose axis
+    lies within 45 degrees of one of the ``held (n, 2)`` axes (:func:`held_axes`)."""
+    axes = np.array([axis_of(yaw, "left"), axis_of(yaw, "front")])
+    return share * ~(np.abs(axes @ held.T) > HELD_COS).any(1)
+
+
 class Centred:
     """A proposer whose objects stand near their anchors' centre lines as often and as far off them as the training
     rooms' do: ``rules`` maps (anchor category, object category, ``support`` | ``spatial`` | ``facing``) to the
@@ -422,7 +446,10 @@ class Centred:
     turned to face it back: an office chair facing its desk stands closer to the desk's line than chairs in front of
     desks at large), and planned left or right of it, the offset along it; a floor object facing a placed object
     with no planned edge to it, the two facing each other within ``facing`` rad at the drawn pose
-    (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it. A drawn place is only as fine as
+    (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it, unless that offset runs along an
+    axis a planned edge holds it on (:func:`held_axes`: a chair planned in front of its table, facing a chair seated
+    at the table's end, stays in front of the table); the same holds for the moves onto a planned anchor's lines (a
+    chair planned in front of a table and beside a chair across it is not moved to that chair's depth). A drawn place is only as fine as
     the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
     proposer's.
     """
@@ -454,14 +481,16 @@ class Centred:
                 elif (*pair, OFF_EDGE) in self.rules:  # the centre lines of the training pairs off that edge
                     line = CentreLine(*self.rules[(*pair, OFF_EDGE)])
                     share = np.asarray(line[:2], float)
+            if a.kind != SUPPORT:  # never off another planned edge's place
+                share = unheld(share, a.frame.yaw, held_axes([b for b in req.anchors if b is not a], yaw))
             xy = self._onto_line(a.frame, xy, share, line, rng)
             if edge is not None:
                 xy = self._within(req.room.boxes[a.obj], xy, edge[1])
-        planned = {a.obj for a in req.anchors}
+        planned, held = {a.obj for a in req.anchors}, held_axes(req.anchors, yaw)
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
             if o not in planned:
-                line = CentreLine(*self.rules[(req.room.categories[o], req.category, "facing")])
-                xy = self._onto_line(box_frame(req.room.boxes[o]), xy, np.array([line.across, 0.0]), line, rng)
+                line, frame = CentreLine(*self.rules[(req.room.categories[o], req.category, "facing")]), box_frame(req.room.boxes[o])
+                xy = self._onto_line(frame, xy, unheld(np.array([line.across, 0.0]), frame.yaw, held), line, rng)
         return xy, yaw
 
     def _turned_to(self, req: Request, obj: int, yaw: float) -> bool:
