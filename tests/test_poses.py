@@ -582,6 +582,7 @@ def test_centring_never_moves_an_object_off_another_planned_edges_place():
     # distant, of the first: the chair/chair rule (every training pair on one line, across and along) would move it
     # to the first chair's depth, behind the table; the table's edge holds it along that axis, so it stays in front.
     # The facing rule likewise leaves the depth of a chair planned in front of the table, facing a chair across it.
+    # Only adjacent and proximal edges hold: a distant one allows any distance beyond the proximal gap.
     from pipeline.placement.anchors import anchors_of
     from pipeline.placement.proposers import Grid, Request
 
@@ -598,6 +599,9 @@ def test_centring_never_moves_an_object_off_another_planned_edges_place():
     alone = Request(table, walls, "chair", "left-right", [a for a in anchors if a.node == "c1"],
                     Grid(table.outline, 0.1), np.ones(1, bool))  # without the table's edge the rule applies
     assert np.allclose(Centred(drawn, rules).pose(alone, np.random.default_rng(0))[0], [3.4, 1.7])
+    loose = [replace(a, distance="distant") for a in anchors]  # a distant edge allows any distance: it holds nothing
+    req = Request(table, walls, "chair", "left-right", loose, Grid(table.outline, 0.1), np.ones(1, bool))
+    assert np.allclose(Centred(drawn, rules).pose(req, np.random.default_rng(0))[0], [3.4, 1.7])
     # facing: c1 turned to face c2's drawn place; c2 planned only in front of the table
     facing = given(given(room, pool, "desk", "table", (2.2, 2.3), 0), pool, "chair", "c1", (2.6, 2.9), -math.degrees(math.pi / 2))
     front = plan_of("c2", "chair", [PlanEdge("table", "c2", "spatial", "front", "proximal")])

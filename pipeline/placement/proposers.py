@@ -25,6 +25,7 @@ from .turns import QUARTER, SupportTurn
 
 WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
 HELD_COS = np.cos(np.pi / 4)  # an axis within 45 degrees of one a planned edge holds the object along is that axis
+HOLDING = ("adjacent", "proximal")  # the distances of the edges that hold an object along their axis
 
 
 @dataclass
@@ -416,11 +417,13 @@ def axis_of(yaw: float, direction: str) -> np.ndarray:
 
 
 def held_axes(anchors: list[Anchor], yaw: float) -> np.ndarray:
-    """``(n, 2)`` world axes along which the object's planned spatial edges hold it: the axis of each edge's direction
-    in its frame (the anchor's; the drawn turn ``yaw`` for a reverse edge, whose direction is in the object's own
-    frame). A wall's edge holds the object at its distance from the wall."""
+    """``(n, 2)`` world axes along which the object's planned adjacent and proximal edges hold it: the axis of each
+    edge's direction in its frame (the anchor's; the drawn turn ``yaw`` for a reverse edge, whose direction is in the
+    object's own frame). A wall's edge holds the object at its distance from the wall. A distant edge holds nothing:
+    it allows any distance beyond the proximal gap (every side wall is distant from a sofa; centring a coffee table
+    on the sofa's line runs along that wall's normal)."""
     axes = [axis_of(yaw if a.reverse else a.frame.yaw, a.direction) for a in anchors
-            if a.kind != SUPPORT and a.direction is not None]
+            if a.kind != SUPPORT and a.direction is not None and a.distance in HOLDING]
     return np.array(axes).reshape(-1, 2)
 
 
