@@ -207,6 +207,7 @@ _GENERATED = [_f("scene_id", _STR, doc="generated scene (= room_id)"),
 SCHEMAS["generated_nodes"] = pa.schema([*SCHEMAS["final_nodes"], *_GENERATED])
 SCHEMAS["generated_edges"] = pa.schema([*SCHEMAS["final_edges"], *_GENERATED])
 SCHEMAS["generated_objects"] = pa.schema([*SCHEMAS["objects"], _f("scene_id", _STR, doc="generated scene (= room_id)")])
+SCORED = ("placed", "partial")  # the scene statuses that hold a room to score (a partial one lacks what it dropped)
 SCHEMAS["scenes"] = pa.schema([
     _f("scene_id", _STR, nullable=False), _f("room_type", _CAT), _f("variant", _CAT, doc="instantiate.variants key"),
     _f("origin_id", _STR, doc="what the scene grew from: the sampled graph it placed (its scene_id in the graph "

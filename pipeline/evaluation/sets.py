@@ -10,8 +10,8 @@ import pandas as pd
 
 from .. import tables
 from ..errors import InputError
-from ..placement.search import SCORED
 from ..room import RoomInput, room_inputs
+from ..tables import SCORED
 
 REAL = "real_heldout"
 

@@ -8,8 +8,8 @@ import numpy as np
 
 from ..evaluation import render
 from ..placement.layout import walls_of
-from ..placement.search import SCORED
 from ..room import RoomInput, room_inputs
+from ..tables import SCORED
 from .interface import Scene, Task
 
 

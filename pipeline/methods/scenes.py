@@ -16,8 +16,8 @@ from .. import tables
 from ..corpus.rows import room_row, wall_rows
 from ..errors import InputError
 from ..placement import export
-from ..placement.search import SCORED
 from ..room import BOX_COLUMNS
+from ..tables import SCORED
 from .interface import Corpus, Scene
 
 log = logging.getLogger("planit.generate")

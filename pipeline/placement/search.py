@@ -78,7 +78,6 @@ class Outcome:
 
 DROP_CAUSES = {"no_place": "no place once the backtrack budget was spent", "no_model": "no training instance",
                "no_span": "planned against two facing walls no instance spans", "support_dropped": "support dropped"}
-SCORED = ("placed", "partial")  # the statuses of scenes that hold a room to score (a partial one lacks what it dropped)
 
 
 def side_plane(a: Anchor, room: RoomInput) -> tuple[np.ndarray, np.ndarray]:

@@ -21,7 +21,7 @@ def _planned(method: str, nodes: list[Path], edges: list[Path]) -> tuple[Path, P
 
 def _placed(scenes: Path, count: int) -> list[str]:
     df = tables.read(scenes, "scenes").to_pandas()
-    return df.loc[df["status"].astype(str).isin(["placed", "partial"]), "scene_id"].astype(str).tolist()[:count]
+    return df.loc[df["status"].astype(str).isin(tables.SCORED), "scene_id"].astype(str).tolist()[:count]
 
 
 def run(config: dict, inp: Files, out: Files, room_type: str, threads: int = 1) -> dict:

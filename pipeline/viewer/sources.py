@@ -57,7 +57,7 @@ def ingested_room(results: Path, room_id: str) -> dict:
 
 def _scene_id(scenes: pd.DataFrame, scene: str, folder: Path) -> str:
     """A scene id given as itself or as its index among the folder's scored scenes."""
-    ids = scenes.loc[scenes["status"].astype(str).isin(["placed", "partial"]), "scene_id"].astype(str).tolist()
+    ids = scenes.loc[scenes["status"].astype(str).isin(tables.SCORED), "scene_id"].astype(str).tolist()
     if scene in ids:
         return scene
     if scene.isdigit() and int(scene) < len(ids):

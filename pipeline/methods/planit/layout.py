@@ -20,11 +20,12 @@ from ...placement.facing import learn_anchor_facing, learn_facing_partners, lear
 from ...placement.layout import walls_of, with_objects
 from ...placement.plan import ScenePlan, plans_from_tables
 from ...placement.prior import KIND as PRIOR_KIND, PosePrior
-from ...placement.search import SCORED, Kit, instantiate
+from ...placement.search import Kit, instantiate
 from ...placement.support import Window, learn_centring
 from ...placement.turns import learn_support_turns
 from ...placement.walls import learn_wall_backs
 from ...seeding import seed_of
+from ...tables import SCORED
 from ..interface import Corpus, Scene, Task
 from ..placing import Context, load_context, scene_of
 from .nets.proposer import NetProposer
