@@ -1,6 +1,7 @@
 """The graph generative model (issue: learn and sample relation graphs): tiny preset, CPU, real procedural graphs."""
 import subprocess
 import sys
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,7 @@ from pipeline.graphs import (
     data as graph_data,  # noqa: E402
 )
 from pipeline.graphs.checks import GraphRules  # noqa: E402
-from pipeline.graphs.data import OBJECT_EDGES, Graph  # noqa: E402
+from pipeline.graphs.data import N_OBJECT_EDGES, OBJECT_EDGES, Graph  # noqa: E402
 from pipeline.learning.epochs import Session  # noqa: E402
 from pipeline.methods.planit.graph_model import (
     sampler,  # noqa: E402
@@ -159,6 +160,21 @@ def test_sampling_never_proposes_unseen_cyclic_or_second_parent_edges(bedrooms, 
         assert "unseen_edge" not in reasons and "cyclic" not in reasons
         parents = [t for s, t, c in g.edges if c == 0]
         assert len(parents) == len(set(parents))
+
+
+def test_an_edge_kind_few_training_graphs_hold_is_never_proposed(bedrooms, model):
+    # graph_model.sample.contents.min_edge_rooms: the kinds only one training graph holds drop out of the mask; the
+    # sampler, which draws some of them with every seen kind allowed, then draws none
+    vocab, graphs = bedrooms
+    triples = lambda g: {(g.node_class[s], g.node_class[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES}
+    held = Counter(t for g in graphs for t in triples(g))
+    every, common = graph_checks.seen_triples(graphs), graph_checks.seen_triples(graphs, 2)
+    rare = every - common
+    assert rare and rare == {t for t, n in held.items() if n == 1} and common == {t for t, n in held.items() if n >= 2}
+    draw = lambda seen: sampler.sample(model, vocab, graphs * 4, seed=1, temperature=1.5,
+                                       limits=sampler.Limits(25, 10, GraphRules(frozenset(seen))))
+    assert any(triples(g) & rare for g in draw(every))
+    assert not any(triples(g) & rare for g in draw(common))
 
 
 SPEC = """

@@ -94,14 +94,14 @@ def link_problems(node_class: list[int], edges: list[tuple[int, int, int]], n_ar
     return out
 
 
-def seen_triples(graphs) -> set[tuple[int, int, int]]:
-    """(anchor class, target class, edge class) of every object edge in ``graphs`` (objects with ``node_class``
-    and ``edges``)."""
-    out = set()
+def seen_triples(graphs, least: int = 1) -> set[tuple[int, int, int]]:
+    """(anchor class, target class, edge class) of the object edges in ``graphs`` (objects with ``node_class`` and
+    ``edges``) that at least ``least`` of the graphs hold."""
+    held: Counter = Counter()
     for g in graphs:
         cls = list(g.node_class)
-        out |= {(cls[s], cls[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES}
-    return out
+        held.update({(cls[s], cls[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES})
+    return {t for t, n in held.items() if n >= least}
 
 
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
