@@ -162,19 +162,20 @@ def test_sampling_never_proposes_unseen_cyclic_or_second_parent_edges(bedrooms, 
         assert len(parents) == len(set(parents))
 
 
-def test_an_edge_kind_few_training_graphs_hold_is_never_proposed(bedrooms, model):
-    # graph_model.sample.contents.min_edge_rooms: the kinds only one training graph holds drop out of the mask; the
-    # sampler, which draws some of them with every seen kind allowed, then draws none
+def test_an_edge_kind_that_joins_few_of_its_categorys_training_objects_is_never_proposed(bedrooms, model):
+    # graph_model.sample.contents.min_edge_share: the kinds whose edges join under 20% of the training objects of
+    # their target category drop out of the mask; the sampler, which draws some of them with every seen kind
+    # allowed, then draws none
     vocab, graphs = bedrooms
-    triples = lambda g: {(g.node_class[s], g.node_class[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES}
-    held = Counter(t for g in graphs for t in triples(g))
-    every, common = graph_checks.seen_triples(graphs), graph_checks.seen_triples(graphs, 2)
+    triples = lambda g: [(g.node_class[s], g.node_class[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES]
+    edges, objects = Counter(t for g in graphs for t in triples(g)), Counter(c for g in graphs for c in g.node_class[g.n_arch:])
+    every, common = graph_checks.seen_triples(graphs), graph_checks.seen_triples(graphs, 0.2)  # 5 rooms: 1 of 10 is rare
     rare = every - common
-    assert rare and rare == {t for t, n in held.items() if n == 1} and common == {t for t, n in held.items() if n >= 2}
+    assert every == set(edges) and rare and rare == {t for t, n in edges.items() if n < 0.2 * objects[t[1]]}
     draw = lambda seen: sampler.sample(model, vocab, graphs * 4, seed=1, temperature=1.5,
                                        limits=sampler.Limits(25, 10, GraphRules(frozenset(seen))))
-    assert any(triples(g) & rare for g in draw(every))
-    assert not any(triples(g) & rare for g in draw(common))
+    assert any(set(triples(g)) & rare for g in draw(every))
+    assert not any(set(triples(g)) & rare for g in draw(common))
 
 
 SPEC = """

@@ -94,14 +94,17 @@ def link_problems(node_class: list[int], edges: list[tuple[int, int, int]], n_ar
     return out
 
 
-def seen_triples(graphs, least: int = 1) -> set[tuple[int, int, int]]:
-    """(anchor class, target class, edge class) of the object edges in ``graphs`` (objects with ``node_class`` and
-    ``edges``) that at least ``least`` of the graphs hold."""
-    held: Counter = Counter()
+def seen_triples(graphs, share: float = 0.0) -> set[tuple[int, int, int]]:
+    """(anchor class, target class, edge class) of the object edges in ``graphs`` (objects with ``node_class``,
+    ``edges`` and ``n_arch``) that join at least ``share`` of the graphs' objects of the target class (0: every one
+    seen)."""
+    edges: Counter = Counter()
+    objects: Counter = Counter()
     for g in graphs:
         cls = list(g.node_class)
-        held.update({(cls[s], cls[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES})
-    return {t for t, n in held.items() if n >= least}
+        edges.update((cls[s], cls[t], c) for s, t, c in g.edges if c < N_OBJECT_EDGES)
+        objects.update(cls[g.n_arch:])
+    return {t for t, n in edges.items() if n >= share * objects[t[1]]}
 
 
 def problems(node_class: list[int], role: list[int], edges: list[tuple[int, int, int]], n_arch: int,
