@@ -155,7 +155,7 @@ def main() -> None:
         metrics = scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker, out.dropped, out.accepted)
         rows.append((out.ok, out.seconds, metrics["consistency"], out.rejections, len(out.relaxed),
                      out.attempts, metrics["plan_loss"], len(out.room.object_ids), out.reason))
-        if out.status in ("placed", "partial"):
+        if out.status in tables.SCORED:
             rooms.append(out.room)
             functional.append(functional_checks.score_room(out.room, learned, fn_cfg, sym))
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())

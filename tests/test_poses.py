@@ -602,6 +602,9 @@ def test_centring_never_moves_an_object_off_another_planned_edges_place():
     loose = [replace(a, distance="distant") for a in anchors]  # a distant edge allows any distance: it holds nothing
     req = Request(table, walls, "chair", "left-right", loose, Grid(table.outline, 0.1), np.ones(1, bool))
     assert np.allclose(Centred(drawn, rules).pose(req, np.random.default_rng(0))[0], [3.4, 1.7])
+    round_ = [replace(a, symmetry="radial") if a.node == "table" else a for a in anchors]  # every edge of it "front"
+    req = Request(table, walls, "chair", "left-right", round_, Grid(table.outline, 0.1), np.ones(1, bool))
+    assert np.allclose(Centred(drawn, rules).pose(req, np.random.default_rng(0))[0], [3.4, 1.7])
     # facing: c1 turned to face c2's drawn place; c2 planned only in front of the table
     facing = given(given(room, pool, "desk", "table", (2.2, 2.3), 0), pool, "chair", "c1", (2.6, 2.9), -math.degrees(math.pi / 2))
     front = plan_of("c2", "chair", [PlanEdge("table", "c2", "spatial", "front", "proximal")])

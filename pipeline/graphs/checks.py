@@ -96,8 +96,8 @@ def link_problems(node_class: list[int], edges: list[tuple[int, int, int]], n_ar
 
 def seen_triples(graphs, share: float = 0.0) -> set[tuple[int, int, int]]:
     """(anchor class, target class, edge class) of the object edges in ``graphs`` (objects with ``node_class``,
-    ``edges`` and ``n_arch``) that join at least ``share`` of the graphs' objects of the target class (0: every one
-    seen)."""
+    ``edges`` and ``n_arch``) of which the graphs hold at least ``share`` edges per object of the target class (0:
+    every kind seen; an object joined twice by one kind counts twice)."""
     edges: Counter = Counter()
     objects: Counter = Counter()
     for g in graphs:

@@ -108,10 +108,11 @@ def link_rules(train: list, cfg: dict) -> graph_checks.LinkRules:
 
 def graph_rules(train: list, vocab, cfg: dict) -> graph_checks.GraphRules:
     """Everything a sampled graph keeps to, from the training graphs (``cfg``: ``graph_model.sample.contents``): seen
-    edge triples, required classes and count caps (:func:`contents_of`), the classes seen near two opposite walls and
-    the link rules (:func:`link_rules`)."""
+    edge triples (those that join at least ``min_edge_share`` of their target category's objects), required classes
+    and count caps (:func:`contents_of`), the classes seen near two opposite walls and the link rules
+    (:func:`link_rules`)."""
     caps, required = contents_of(train, vocab, cfg)
-    return graph_checks.GraphRules(frozenset(graph_checks.seen_triples(train)), frozenset(required),
+    return graph_checks.GraphRules(frozenset(graph_checks.seen_triples(train, cfg["min_edge_share"])), frozenset(required),
                                    frozenset(graph_checks.opposite_classes(train)), link_rules(train, cfg), caps)
 
 

@@ -416,14 +416,16 @@ def axis_of(yaw: float, direction: str) -> np.ndarray:
     return np.array([-s, c]) if direction in ("front", "back") else np.array([c, s])
 
 
-def held_axes(anchors: list[Anchor], yaw: float) -> np.ndarray:
+def held_axes(anchors: list[Anchor], yaw: float, symmetry: str = "none") -> np.ndarray:
     """``(n, 2)`` world axes along which the object's planned adjacent and proximal edges hold it: the axis of each
     edge's direction in its frame (the anchor's; the drawn turn ``yaw`` for a reverse edge, whose direction is in the
     object's own frame). A wall's edge holds the object at its distance from the wall. A distant edge holds nothing:
     it allows any distance beyond the proximal gap (every side wall is distant from a sofa; centring a coffee table
-    on the sofa's line runs along that wall's normal)."""
+    on the sofa's line runs along that wall's normal). A radially symmetric frame (``symmetry``: the object's own, for
+    reverse edges) holds nothing either: extraction labels all its edges front, so its front axis is arbitrary."""
     axes = [axis_of(yaw if a.reverse else a.frame.yaw, a.direction) for a in anchors
-            if a.kind != SUPPORT and a.direction is not None and a.distance in HOLDING]
+            if a.kind != SUPPORT and a.direction is not None and a.distance in HOLDING
+            and (symmetry if a.reverse else a.symmetry) != "radial"]
     return np.array(axes).reshape(-1, 2)
 
 
@@ -485,11 +487,11 @@ class Centred:
                     line = CentreLine(*self.rules[(*pair, OFF_EDGE)])
                     share = np.asarray(line[:2], float)
             if a.kind != SUPPORT:  # never off another planned edge's place
-                share = unheld(share, a.frame.yaw, held_axes([b for b in req.anchors if b is not a], yaw))
+                share = unheld(share, a.frame.yaw, held_axes([b for b in req.anchors if b is not a], yaw, req.symmetry))
             xy = self._onto_line(a.frame, xy, share, line, rng)
             if edge is not None:
                 xy = self._within(req.room.boxes[a.obj], xy, edge[1])
-        planned, held = {a.obj for a in req.anchors}, held_axes(req.anchors, yaw)
+        planned, held = {a.obj for a in req.anchors}, held_axes(req.anchors, yaw, req.symmetry)
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
             if o not in planned:
                 line, frame = CentreLine(*self.rules[(req.room.categories[o], req.category, "facing")]), box_frame(req.room.boxes[o])

@@ -47,9 +47,8 @@ def sample_room_type(config: dict, request: GraphRequest, threads: int = 1) -> t
     held = [by_id[i] for i in saved["heldout_ids"] if i in by_id]
     heldout_ids = set(saved["heldout_ids"])
     train_graphs = [g for g in graphs if g.room_id not in heldout_ids]
-    common = graph_checks.seen_triples(train_graphs, sc["contents"]["min_edge_share"])
-    rules = replace(graph_rules(train_graphs, vocab, sc["contents"]),
-                    seen=frozenset(tuple(t) for t in saved["seen"]) & common)
+    rules = graph_rules(train_graphs, vocab, sc["contents"])  # seen: also in the model's own training graphs
+    rules = replace(rules, seen=frozenset(tuple(t) for t in saved["seen"]) & rules.seen)
     plan = None
     if spec is not None:
         plan, arch_from = load_spec(spec, room_type, vocab)
