@@ -54,7 +54,7 @@ def main() -> None:
     args = ap.parse_args()
     config = config_mod.load(ROOT / "config" / "config.yaml")
     off = copy.deepcopy(config)
-    off["graph_model"]["sample"]["contents"] = {"cap_counts": False, "required_share": 2.0, "links": "none"}
+    off["graph_model"]["sample"]["contents"] = {"cap_counts": False, "required_share": 2.0, "links": "none", "min_edge_share": 0.0}
     result = {"graphs": args.graphs}
     for room_type in args.room_types:
         train, held = real_categories(room_type)

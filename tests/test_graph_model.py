@@ -357,7 +357,8 @@ def test_a_room_string_is_read_back_into_its_room_and_broken_ones_are_rejected_b
     from test_strings import isomorphic
 
     vocab, graphs = bedrooms
-    rules = Rules(graphs, vocab, "neighbour", {"cap_counts": True, "required_share": 0.95, "links": "required"})
+    rules = Rules(graphs, vocab, "neighbour", {"cap_counts": True, "required_share": 0.95, "links": "required",
+                                              "min_edge_share": 0.0})
     room = graphs[0]
     text = serialize_room(string_graph(room, vocab), room.n_arch, np.random.default_rng(1))
     grown, bad = to_grown(text, room, vocab, rules)
