@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline import tables
 from pipeline.evaluation.distributions import category_kl
 
 
@@ -33,7 +34,7 @@ def main() -> None:
     real = split_categories(run, room_type, split)
     for folder in map(Path, sys.argv[4:]):
         scenes = pd.read_parquet(folder / "scenes.parquet")
-        placed = set(scenes.loc[scenes["status"] != "failed", "scene_id"])
+        placed = set(scenes.loc[scenes["status"].astype(str).isin(tables.SCORED), "scene_id"])
         objects = pd.read_parquet(folder / "objects.parquet")
         cats = objects.loc[objects["room_id"].isin(placed), "category"].astype(str).tolist()
         print(f"{folder}: rooms {len(placed)}, objects per room {len(cats) / max(len(placed), 1):.1f}, "

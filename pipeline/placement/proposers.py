@@ -454,9 +454,9 @@ class Centred:
     (:func:`~pipeline.geometry.function.facing_each_other`), the offset across it, unless that offset runs along an
     axis a planned edge holds it on (:func:`held_axes`: a chair planned in front of its table, facing a chair seated
     at the table's end, stays in front of the table); the same holds for the moves onto a planned anchor's lines (a
-    chair planned in front of a table and beside a chair across it is not moved to that chair's depth). A drawn place is only as fine as
-    the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn is the base
-    proposer's.
+    chair planned in front of a table and beside a chair across it is not moved to that chair's depth). A drawn place
+    is only as fine as the proposer's grid or network (0.15 m per pixel for PlanIT's at the default preset); the turn
+    is the base proposer's.
     """
 
     def __init__(self, base, rules: dict[tuple[str, str, str], tuple], facing: float = np.pi / 4):
@@ -494,7 +494,8 @@ class Centred:
         planned, held = {a.obj for a in req.anchors}, held_axes(req.anchors, yaw, req.symmetry)
         for o in ([] if any(a.kind == SUPPORT for a in req.anchors) else self._facing(req, xy, yaw)):
             if o not in planned:
-                line, frame = CentreLine(*self.rules[(req.room.categories[o], req.category, "facing")]), box_frame(req.room.boxes[o])
+                line = CentreLine(*self.rules[(req.room.categories[o], req.category, "facing")])
+                frame = box_frame(req.room.boxes[o])
                 xy = self._onto_line(frame, xy, unheld(np.array([line.across, 0.0]), frame.yaw, held), line, rng)
         return xy, yaw
 
