@@ -73,7 +73,7 @@ def _placement_reasons(room, objs: dict, cfg: dict) -> list[tuple[str, str]]:
     depth = boxes.penetration_depths(b)
     related = (parents[:, None] == ids[None, :]) | (parents[None, :] == ids[:, None])
     depth[related] = 0.0
-    worst = deepest_penetration(depth, objs, cfg)
+    worst = deepest_penetration(depth, objs, cfg, exact=True)  # its depth is reported
     if worst is not None:
         i, j, d, measure = worst
         out.append(("interpenetration", f"{ids[i]} and {ids[j]} interpenetrate by {d:.2f} m ({measure})"))

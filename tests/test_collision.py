@@ -239,3 +239,27 @@ def test_interleaved_bookshelves_collide_for_the_placement_checks_the_filter_and
                                  "evaluate": {"collision": {"penetration": off}}})
     placed, evaluated, kept = verdicts(grid_only)
     assert placed is None and evaluated == [False, False] and kept.status == "kept"
+
+
+@pytest.mark.parametrize("setting", ["evaluate", "instantiate"])
+def test_a_measure_that_stops_past_the_limit_gives_every_pair_the_full_measures_verdict(setting, monkeypatch):
+    """``enough``: the search and the evaluation ask only whether a pair penetrates deeper than the limit, so the
+    surface screen is skipped where the coarse grid already finds more. Over hand-built pairs from apart to deep
+    (boxes, bookshelves whose panels interleave, a table and an L-shaped sofa), the verdict at the limit is the
+    full measure's and the depth returned is never above it; the screen runs on fewer pairs."""
+    pen = SETTINGS[setting]
+    cube = meshes.box((1.0, 1.0, 1.0), (0, 0, 0.5))
+    pairs = [(placed(cube, (0, 0)), placed(cube, (1.0 - d, 0.2))) for d in (-0.01, 0.0, 0.005, 0.02, 0.05, 0.3)]
+    pairs += [(bookshelf(), shifted(bookshelf(s), o)) for s, o in [(5, (0.4, 0.0, SPACING / 2)), (4, (0.5, 0.05, 0.0)),
+                                                                   (5, (0.81, 0.0, 0.0)), (5, (0.2, 0.1, 0.0))]]
+    pairs += [(placed(table_mesh(1.2, 0.6, 0.45), (0, 0)), placed(l_sofa_mesh(), (x, 0.3), 90.0))
+              for x in (0.3, 0.9, 1.6)]
+    screens = []  # the real screen, counted
+    monkeypatch.setattr(collision, "surface_depth", lambda *a, _f=collision.surface_depth: screens.append(1) or _f(*a))
+    full = [collision.mesh_penetration(a, b, EMBREE, pen) for a, b in pairs]
+    screened = len(screens)
+    quick = [collision.mesh_penetration(a, b, EMBREE, pen, enough=LIMIT) for a, b in pairs]
+    assert [q > LIMIT for q in quick] == [f > LIMIT for f in full]
+    assert all(q <= f + 1e-12 for q, f in zip(quick, full))
+    assert sum(f > LIMIT for f in full) >= 5 and sum(f <= LIMIT for f in full) >= 3
+    assert len(screens) - screened < screened  # the quick measure skips the screen on pairs already past it

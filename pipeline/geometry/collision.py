@@ -89,12 +89,14 @@ def thickness(mask: np.ndarray, pitch: float) -> float:
 
 
 def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], intersector: type[Any],
-                     cfg: dict[str, Any]) -> float:
+                     cfg: dict[str, Any], enough: float = np.inf) -> float:
     """Penetration depth (m) of two meshes in world coordinates, each ``(vertices (n, 3), faces (m, 3))``; ``cfg``:
     ``resolution``, ``min_pitch`` (m) and ``max_cells`` of the sampling grid; ``surface_spacing`` (m; null: no
     screen), ``max_surface_points``, ``surface_window`` (m) and ``max_windows`` of the surface screen
     (:func:`surface_depth`), which runs where the grid finds less than two pitches: a region the grid misses is
-    thinner than that (at most sqrt 3 pitches), so where it finds more the screen cannot find deeper."""
+    thinner than that (at most sqrt 3 pitches), so where it finds more the screen cannot find deeper. ``enough``
+    (m): a caller that asks only whether the depth exceeds it gets the grid's depth, without the screen, once that
+    already does (a lower bound above ``enough``, never a different verdict)."""
     lo, hi = box_overlap(a[0].min(0), a[0].max(0), b[0].min(0), b[0].max(0))
     if np.any(hi <= lo):
         return 0.0
@@ -104,7 +106,7 @@ def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.n
     both = inside_scene(scenes[0], points)
     both[both] = inside_scene(scenes[1], points[both])  # only the points inside the first mesh can be in both
     depth = thickness(both.reshape(cells.shape[:3]), pitch)
-    if cfg["surface_spacing"] is None or depth >= 2 * pitch:
+    if cfg["surface_spacing"] is None or depth >= 2 * pitch or depth > enough:
         return depth
     return max(depth, surface_depth((a, b), scenes, lo, hi, cfg))
 
@@ -182,13 +184,15 @@ def window_depth(scenes: tuple[RoomScene, RoomScene], seeds: np.ndarray, lo: np.
     return thickness(np.pad(windows, ((0, 0), (1, 1), (1, 1), (1, 1))).reshape(-1, side + 2, side + 2), pitch)
 
 
-def penetrating_pairs(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any]) -> Iterator[tuple[int, int, float, str]]:
+def penetrating_pairs(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any],
+                      exact: bool = False) -> Iterator[tuple[int, int, float, str]]:
     """Pairs ``(i, j, depth, measure)``, deepest box overlap first, that penetrate deeper than ``max_penetration``:
     measured on the meshes where both objects have one (``penetration.measure: mesh``), else on the boxes.
 
     ``cfg['confirm']`` (optional, a finer ``penetration``): a mesh pair the first grid clears is measured again on
     this one, so a coarse grid may screen but never clear a pair that the finer measure finds penetrating (the
-    depth is accurate to one pitch only)."""
+    depth is accurate to one pitch only). ``exact``: each pair's depth measured in full; else a mesh pair's depth is
+    a lower bound above ``max_penetration`` where the coarse grid alone shows it penetrating (the same pairs)."""
     pen, limit = cfg["penetration"], cfg["max_penetration"]
     i, j = np.nonzero(np.triu(box_depth > limit, 1))
     for k in np.argsort(-box_depth[i, j], kind="stable"):
@@ -197,24 +201,30 @@ def penetrating_pairs(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str
         if pen["measure"] == "box" or ma is None or mb is None:
             yield a, b, float(box_depth[a, b]), "boxes"
             continue
-        d = _mesh_depth(world_mesh(ma, objs["poses"][a]), world_mesh(mb, objs["poses"][b]), float(box_depth[a, b]), cfg)
+        d = _mesh_depth(world_mesh(ma, objs["poses"][a]), world_mesh(mb, objs["poses"][b]), float(box_depth[a, b]), cfg,
+                        np.inf if exact else limit)
         if d > limit:
             yield a, b, d, "meshes"
 
 
-def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], box_depth: float, cfg: dict[str, Any]) -> float:
+def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], box_depth: float,
+                cfg: dict[str, Any], enough: float) -> float:
     """Two world meshes' penetration on ``cfg['penetration']``'s grid, measured again on ``cfg['confirm']``'s where
-    the first finds at most ``max_penetration`` (``confirm.measure: box`` takes the boxes' depth instead)."""
-    d = mesh_penetration(a, b, cfg["intersector"], cfg["penetration"])
+    the first finds at most ``max_penetration`` (``confirm.measure: box`` takes the boxes' depth instead); each
+    measure stops once past ``enough`` (:func:`mesh_penetration`)."""
+    d = mesh_penetration(a, b, cfg["intersector"], cfg["penetration"], enough)
     confirm = cfg.get("confirm")
     if confirm is None or d > cfg["max_penetration"]:
         return d
-    return box_depth if confirm["measure"] == "box" else mesh_penetration(a, b, cfg["intersector"], confirm)
+    if confirm["measure"] == "box":
+        return box_depth
+    return mesh_penetration(a, b, cfg["intersector"], confirm, enough)
 
 
-def deepest_penetration(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any]) -> tuple[int, int, float, str] | None:
+def deepest_penetration(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any],
+                        exact: bool = False) -> tuple[int, int, float, str] | None:
     """The first of :func:`penetrating_pairs` (None if no pair penetrates)."""
-    return next(penetrating_pairs(box_depth, objs, cfg), None)
+    return next(penetrating_pairs(box_depth, objs, cfg, exact), None)
 
 
 def world_mesh(mesh: tuple[np.ndarray, np.ndarray], pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

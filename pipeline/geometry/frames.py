@@ -47,6 +47,12 @@ class Frame:
         return Frame(self.origin, self.yaw + angle, self.mirror != mirror)
 
 
+def front_of(yaw: ArrayLike) -> np.ndarray:
+    """``(..., 2)`` world unit vector an object turned ``yaw (...)`` (rad) faces: its local +y (yaw 0 faces +y)."""
+    y = np.asarray(yaw, float)
+    return np.stack([-np.sin(y), np.cos(y)], -1)
+
+
 def to_local(frame: Frame, points: np.ndarray) -> np.ndarray:
     """World ``(..., 2)`` points -> frame coordinates."""
     c, s = np.cos(frame.yaw), np.sin(frame.yaw)

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .boxes import footprint_corners, footprint_overlap, point_box, rotation
-from .frames import FOLD, RADIAL_FRAMES, turn_error, wrap
+from .frames import FOLD, RADIAL_FRAMES, front_of, turn_error, wrap
 from .polygon import inward_normals, make_ccw, polygon_segments
 
 REGIONS = ("front", "back", "side_front", "side_back", "corner", "over")
@@ -95,7 +95,7 @@ def faces_wall(xy: np.ndarray, yaw: ArrayLike, a: np.ndarray, b: np.ndarray, nor
     (square to it, so that whatever stands with its back to the wall faces it back) and its front ray meeting the
     segment. A sofa facing the wall its television stand will stand against; not a wall it sees along its length."""
     xy, yaw = np.asarray(xy, float).reshape(-1, 2), np.broadcast_to(np.asarray(yaw, float), (len(xy),))
-    front = np.stack([-np.sin(yaw), np.cos(yaw)], -1)
+    front = front_of(yaw)
     square = np.arccos(np.clip(front @ -np.asarray(normal, float), -1.0, 1.0)) <= limit
     along, rel = np.asarray(b, float) - a, np.asarray(a, float) - xy  # segment a + s * along meets xy + t * front
     cross = lambda u, v: u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
@@ -146,7 +146,7 @@ def facing_angles(boxes: np.ndarray, symmetry: ArrayLike | None = None) -> np.nd
     inside = np.all(np.abs(local) <= half, axis=-1)
     near = np.where(inside[..., None], 0.0, near)
     to_anchor = np.einsum("aij,atj->ati", rotation(b[:, 6]), near - local)  # world direction target -> anchor
-    front = np.stack([-np.sin(b[:, 6]), np.cos(b[:, 6])], -1)[None]  # (1, target, 2)
+    front = front_of(b[:, 6])[None]  # (1, target, 2)
     cross = front[..., 0] * to_anchor[..., 1] - front[..., 1] * to_anchor[..., 0]
     angle = np.arctan2(cross, np.einsum("atj,atj->at", to_anchor, front))
     return turn_error(angle, "none" if symmetry is None else np.asarray(symmetry, object)[None, :])
@@ -170,7 +170,7 @@ def in_front(boxes: np.ndarray, points: np.ndarray, limit: float) -> np.ndarray:
     stand's front turned towards the sofa), for a whole grid at once."""
     b = np.asarray(boxes, float).reshape(-1, 7)
     d = np.asarray(points, float).reshape(-1, 2)[:, None, :] - b[None, :, :2]  # (n, m, 2)
-    front = np.stack([-np.sin(b[:, 6]), np.cos(b[:, 6])], -1)[None]  # (1, m, 2)
+    front = front_of(b[:, 6])[None]  # (1, m, 2)
     cos = np.einsum("nmj,nmj->nm", d, front) / np.maximum(np.linalg.norm(d, axis=-1), 1e-12)
     out: np.ndarray = (cos >= np.cos(limit)).any(axis=1)
     return out
@@ -192,7 +192,7 @@ def back_to_wall(boxes: np.ndarray, outline: np.ndarray, max_gap: float, max_ang
     step = 2 * np.pi / np.maximum(fold, 1)
     eq = np.where(fold == 0, wall_yaw[None], b[:, 6, None] + step * np.round(wrap(wall_yaw[None] - b[:, 6, None]) / step))
     depth = np.where(np.abs(np.sin(eq - b[:, 6, None])) > 0.5, b[:, 3, None], b[:, 4, None])  # (n, w)
-    mid = b[:, None, :2] + np.stack([np.sin(eq), -np.cos(eq)], -1) * depth[..., None]  # the equivalent back's midpoint
+    mid = b[:, None, :2] - front_of(eq) * depth[..., None]  # the equivalent back's midpoint
     rel = mid - walls[None, :, 0]  # (n, w, 2)
     d = walls[:, 1] - walls[:, 0]
     along = np.einsum("nwj,wj->nw", rel, d) / np.maximum(np.einsum("wj,wj->w", d, d), 1e-18)

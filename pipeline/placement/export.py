@@ -11,6 +11,7 @@ import numpy as np
 
 from ..geometry import meshes
 from ..geometry.boxes import footprint_corners
+from ..geometry.frames import front_of
 from ..geometry.polygon import nearest_segment
 from ..room import RoomInput, Walls, wall_footprints
 from .plan import PlanEdge
@@ -110,7 +111,7 @@ def plan_figure(room: RoomInput, walls: Walls, edges: list[PlanEdge], title: str
     for k, (oid, cat) in enumerate(zip(room.object_ids, room.categories)):
         fp = footprint_corners(*b[k, [0, 1, 3, 4, 6]])[0]
         ax.add_patch(Polygon(fp, closed=True, facecolor=cmap(cats.index(cat) % 20), alpha=0.55, edgecolor="k", lw=0.6))
-        front = b[k, :2] + np.array([-np.sin(b[k, 6]), np.cos(b[k, 6])]) * b[k, 4]
+        front = b[k, :2] + front_of(b[k, 6]) * b[k, 4]
         ax.plot(*zip(b[k, :2], front), color="k", lw=0.6)
         ax.text(*b[k, :2], f"{oid}\n{cat}", fontsize=5, ha="center", va="center")
         centre[oid] = b[k, :2]

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..geometry import raster
 from ..geometry.boxes import SIDES, diagonal_2d, point_box
-from ..geometry.frames import to_local, to_world, turn_error, wrap
+from ..geometry.frames import front_of, to_local, to_world, turn_error, wrap
 from ..geometry.function import faces_wall, facing_angles, facing_each_other, facing_turn, in_front
 from ..geometry.polygon import nearest_segment
 from ..geometry.relations import distance_thresholds
@@ -24,7 +24,7 @@ from .support import EDGES, OFF_EDGE, CentreLine, EdgeRule, half_depth_on
 from .turns import QUARTER, SupportTurn
 
 WALL_DEPTH = 1e-3  # m, half depth of a wall's segment standing in as a box (FacingPartner)
-HELD_COS = np.cos(np.pi / 4)  # an axis within 45 degrees of one a planned edge holds the object along is that axis
+HELD_COS = np.cos(np.pi / 4)  # no tuning: the bisector of a frame's two axes, so a held axis holds the nearer of them
 HOLDING = ("adjacent", "proximal")  # the distances of the edges that hold an object along their axis
 
 
@@ -412,8 +412,7 @@ class Masked(DensityProposer):
 def axis_of(yaw: float, direction: str) -> np.ndarray:
     """The world unit axis ``(2,)`` along which a frame turned ``yaw`` (rad) measures ``direction``: its local y for
     ``front``/``back``, its local x for ``left``/``right``."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([-s, c]) if direction in ("front", "back") else np.array([c, s])
+    return front_of(yaw) if direction in ("front", "back") else front_of(yaw - np.pi / 2)
 
 
 def held_axes(anchors: list[Anchor], yaw: float, symmetry: str = "none") -> np.ndarray:
