@@ -5,6 +5,7 @@ graph is comparable with its plan."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 import shapely
@@ -77,6 +78,23 @@ def support_shares(children: np.ndarray, parents: np.ndarray) -> np.ndarray:
     c, p = (shapely.polygons(boxes.footprint_corners(b[:, 0], b[:, 1], b[:, 3], b[:, 4], b[:, 6]))
             for b in (np.asarray(children, float).reshape(-1, 7), np.asarray(parents, float).reshape(-1, 7)))
     return shapely.area(shapely.intersection(c, p)) / np.maximum(shapely.area(c), 1e-12)
+
+
+def centred_shares(half: np.ndarray, support_half: np.ndarray) -> np.ndarray:
+    """``(n, m)`` share of the footprint of each of the half extents ``half (m, >= 2)`` (m) over a support of each of
+    ``support_half (n, >= 2)``, centred on its top and square to it, the better of the two square turns: what
+    :func:`support_shares` measures for such a place (the overlap of two centred rectangles), in closed form."""
+    h, s = np.asarray(half, float)[None, :, :2], np.asarray(support_half, float)[:, None, :2]
+    area = np.maximum(h.prod(-1), 1e-12)
+    out: np.ndarray = np.maximum(np.minimum(h, s).prod(-1), np.minimum(h[..., ::-1], s).prod(-1)) / area
+    return out
+
+
+def fits_on(support: np.ndarray, least: float, half: np.ndarray) -> np.ndarray:
+    """``(n,)`` bool: a footprint of each of the half extents ``half (n, >= 2)`` (m), centred on ``support (7,)``'s top
+    and square to it either way, keeps at least ``least`` of its area over it (:func:`centred_shares`): the best any
+    place on the support can do for it turned square."""
+    return cast(np.ndarray, centred_shares(half, np.asarray(support, float)[None, 3:5])[0] >= least - 1e-9)
 
 
 def support_share(child: np.ndarray, parent: np.ndarray) -> float:

@@ -3,6 +3,7 @@ training rooms (the category's empirical size prior; PlanIT retrieves the model 
 Symmetry must match the planned node's where the category has such instances."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +30,7 @@ class ModelPool:
     def __init__(self, objects: pd.DataFrame, symmetry: dict[str, str], floor_contact: float = 0.05):
         self.by_cat: dict[str, list[Instance]] = {}
         self.sym: dict[str, list[str]] = {}
+        self._sizes: dict[str, np.ndarray] = {}
         b = objects[BOX_COLUMNS].to_numpy(float)
         p = objects[["px", "py", "pz"]].to_numpy(float)
         s = objects[["sx", "sy", "sz"]].to_numpy(float)
@@ -43,15 +45,26 @@ class ModelPool:
     def has(self, category: str) -> bool:
         return category in self.by_cat
 
-    def pick(self, category: str, symmetry: str, rng: np.random.Generator, grounded: bool = False) -> Instance:
+    def sizes(self, category: str) -> np.ndarray:
+        """``(m, 2)`` the category's distinct footprint half extents (m), computed once."""
+        if category not in self._sizes:
+            self._sizes[category] = np.unique(np.array([i.half[:2] for i in self.by_cat[category]]), axis=0)
+        return self._sizes[category]
+
+    def pick(self, category: str, symmetry: str, rng: np.random.Generator, grounded: bool = False,
+             fits: Callable[[np.ndarray], np.ndarray] | None = None) -> Instance:
         """A random instance of the category, of the node's symmetry where the category has one; ``grounded``: one
         that stood on the floor where the category has such (a floor node with planned spatial edges: extraction
-        sees no spatial relation of an object hanging above the floor, e.g. an AI2-THOR counter-top slab)."""
+        sees no spatial relation of an object hanging above the floor, e.g. an AI2-THOR counter-top slab); ``fits``:
+        ``(n, 3)`` half extents -> ``(n,)`` bool, one it accepts where the category has such (an object planned on a
+        placed support: one that can stand on it, :func:`~pipeline.placement.checks.fits_on`)."""
         if category not in self.by_cat:
             raise KeyError(f"no training instance of category '{category}'")
         pool = self.by_cat[category]
         keep = [k for k, inst in enumerate(pool) if inst.lift == 0.0] if grounded else []
         keep = keep or list(range(len(pool)))
+        if fits is not None:
+            keep = [k for k, ok in zip(keep, fits(np.array([pool[k].half for k in keep]))) if ok] or keep
         same = [k for k in keep if self.sym[category][k] == symmetry]
         return pool[int(rng.choice(same or keep))]
 

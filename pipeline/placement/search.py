@@ -30,6 +30,7 @@ import logging
 import time
 from collections import Counter
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import NamedTuple, Protocol
 
 import numpy as np
@@ -38,7 +39,7 @@ from ..geometry.boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
 from ..geometry.relations import in_footprint
 from ..room import RoomInput, Walls
 from .anchors import Anchor, anchors_of, planned_edges
-from .checks import Checker, check
+from .checks import Checker, centred_shares, check, fits_on
 from .layout import add_object, walls_of, with_objects
 from .order import chains
 from .plan import ScenePlan
@@ -189,14 +190,30 @@ class Search:
 
     def model_for(self, k: int):
         """The instance for object ``k``: spokes of one hub share one, chain members copy their chain's; a floor node
-        with planned spatial edges takes one that stood on the floor (:meth:`ModelPool.pick`)."""
+        with planned spatial edges takes one that stood on the floor; one that fits its support and its children where
+        the category has such (:meth:`fits`; :meth:`ModelPool.pick`)."""
         cat, key = self.plan.categories[k], self.model_key(k)
         if key not in self.shared:
-            v = self.plan.ids[k]
-            grounded = self.plan.parent[k] is None and any(
+            v, parent = self.plan.ids[k], self.plan.parent[k]
+            grounded = parent is None and any(
                 e.edge_type == "spatial" and v in (e.source, e.target) for e in self.plan.edges)
-            self.shared[key] = self.pool.pick(cat, self.plan.symmetry[k], self.rng, grounded)
+            self.shared[key] = self.pool.pick(cat, self.plan.symmetry[k], self.rng, grounded, partial(self.fits, k))
         return self.shared[key]
+
+    def fits(self, k: int, half: np.ndarray) -> np.ndarray:
+        """``(n,)`` bool: which instances of half extents ``half (n, 3)`` object ``k`` can take so that it can stand on
+        its support, if placed, and each category it is planned to support has an instance that can stand on it
+        (:func:`~pipeline.placement.checks.fits_on`: centred and square, with the share the support check asks): a
+        television no wider than the stand placed for it, a side table that some television of the training rooms
+        fits on."""
+        ok = np.ones(len(half), bool)
+        parent, v = self.plan.parent[k], self.plan.ids[k]
+        if parent in self.room.object_ids:
+            ok &= fits_on(self.room.boxes[self.room.object_ids.index(parent)], self.checker.min_support(self.plan.categories[k]), half)
+        sizes, back = np.unique(np.asarray(half, float)[:, :2], axis=0, return_inverse=True)
+        for cat in {c for c, p in zip(self.plan.categories, self.plan.parent) if p == v and self.pool.has(c)}:
+            ok &= (centred_shares(self.pool.sizes(cat), sizes) >= self.checker.min_support(cat) - 1e-9).any(1)[back.ravel()]
+        return ok
 
     def occupied(self, grow: float, room: RoomInput | None = None) -> np.ndarray:
         """``(cells,)`` candidate centres inside a placed floor object's footprint grown by ``grow`` m (in ``room``,

@@ -30,10 +30,10 @@ def _parts(paths: list[Path], schema: str):
                 yield part
 
 
-def run(config: dict, inputs: Files, outputs: Files) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
     """Stream each table's shards into one file, room type by room type (each shard keeps its room order)."""
     counts = {}
     for name, schema in SCHEMA_OF.items():
-        counts[name] = tables.write_parts(outputs[name], schema, _parts(inputs[name], schema),
-                                          {"shards": str(len(inputs[name]))})
+        counts[name] = tables.write_parts(out[name], schema, _parts(inp[name], schema),
+                                          {"shards": str(len(inp[name]))})
     return counts

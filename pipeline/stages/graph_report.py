@@ -5,8 +5,8 @@ from ..graphs.report import graph_report, write_report
 from ..stage import Files
 
 
-def run(config: dict, inp: Files, outputs: Files) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
     nodes, edges, superstructures = inp.nodes, inp.edges, inp.superstructures
     report = graph_report(nodes, edges, superstructures)
-    write_report(report, outputs)
+    write_report(report, out)
     return {name: len(df) for name, df in report.items()}

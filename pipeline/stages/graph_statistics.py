@@ -15,7 +15,7 @@ log = logging.getLogger("planit.graphs")
 STAT_TABLES = ("cooccurrence", "relations", "hub_patterns", "category_sizes")
 
 
-def run(config: dict, inp: Files, outputs: Files) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
     partials, nodes = inp.partial, inp.nodes
     for p in partials:  # a missing or corrupt shard is named here, not deep inside DuckDB
         tables.check(p, "partial_counts")
@@ -25,7 +25,7 @@ def run(config: dict, inp: Files, outputs: Files) -> dict:
     stats = gather(partials, nodes, min_count)
     extra = {"config_hash": config_hash(min_count)}
     for name in STAT_TABLES:
-        tables.write(outputs[name], name, pa.Table.from_pandas(stats[name], preserve_index=False), extra)
+        tables.write(out[name], name, pa.Table.from_pandas(stats[name], preserve_index=False), extra)
     summary = {name: len(stats[name]) for name in STAT_TABLES}
     summary["accepted_hub_patterns"] = int(stats["hub_patterns"]["accepted"].sum()) if len(stats["hub_patterns"]) else 0
     log.info("graph statistics: %s", summary)

@@ -13,12 +13,12 @@ from ..stage import Files
 log = logging.getLogger("planit.ingest")
 
 
-def run(config: dict, inp: Files, outputs: Files, shard: int) -> dict[str, int]:
-    """Ingest shard ``shard`` of ``config['source']`` and write every table of ``OUTPUTS`` to ``outputs``."""
+def run(config: dict, inp: Files, out: Files, shard: int) -> dict[str, int]:
+    """Ingest shard ``shard`` of ``config['source']`` and write every table of ``OUTPUTS`` to ``out``."""
     result = ingest_shard(config, shard)
     extra = {"source": config["source"], "config_hash": config_hash(config), "shard": str(shard)}
     for name in OUTPUTS:
-        tables.write(outputs[name], name, result[name], extra)
+        tables.write(out[name], name, result[name], extra)
     counts = {name: result[name].num_rows for name in OUTPUTS}
     log.info("ingested %s shard %d: %s", config["source"], shard, counts)
     for reason, n in Counter(d["reason"] for d in result["drops"].to_pylist()).most_common(5):

@@ -27,7 +27,7 @@ def load_stats(relations: Path, hub_patterns: Path, category_sizes: Path) -> Sta
     return s
 
 
-def run(config: dict, inp: Files, outputs: Files, shard: int) -> dict:
+def run(config: dict, inp: Files, out: Files, shard: int) -> dict:
     nodes, edges, candidates, stats = inp.nodes, inp.edges, inp.candidates, inp
     cfg = config["refine"]
     st = load_stats(stats["relations"], stats["hub_patterns"], stats["category_sizes"])
@@ -44,12 +44,12 @@ def run(config: dict, inp: Files, outputs: Files, shard: int) -> dict:
         if r.cyclic:
             cyclic.append(room_id)
     extra = {"config_hash": config_hash(cfg), "shard": str(shard)}
-    tables.write(outputs["nodes"], "final_nodes", tables.from_rows("final_nodes", out_nodes), extra)
-    tables.write(outputs["edges"], "final_edges", tables.from_rows("final_edges", out_edges), extra)
-    tables.write(outputs["superstructures"], "superstructures", tables.from_rows("superstructures", supers), extra)
+    tables.write(out["nodes"], "final_nodes", tables.from_rows("final_nodes", out_nodes), extra)
+    tables.write(out["edges"], "final_edges", tables.from_rows("final_edges", out_edges), extra)
+    tables.write(out["superstructures"], "superstructures", tables.from_rows("superstructures", supers), extra)
     summary = {"shard": shard, "rooms": len(node_rows), "edges": len(out_edges),
                "kept": sum(e["status"] == "kept" for e in out_edges), "repaired": repaired,
                "cyclic_rooms": len(cyclic), "cyclic_room_ids": cyclic}
-    tables.write_json(outputs["summary"], summary)
+    tables.write_json(out["summary"], summary)
     log.info("refined shard %d: %s", shard, {k: v for k, v in summary.items() if k != "cyclic_room_ids"})
     return summary

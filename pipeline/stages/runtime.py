@@ -70,19 +70,19 @@ def with_budgets(table: pd.DataFrame, budget: dict) -> pd.DataFrame:
     return out
 
 
-def run(config: dict, inp: Files, outputs: Files, benchmarks: str) -> pd.DataFrame:
-    out = outputs.table
+def run(config: dict, inp: Files, out: Files, benchmarks: str) -> pd.DataFrame:
+    path = out.table
     budget = config["runtime"]
     jobs = read_benchmarks(Path(benchmarks))
     table = with_budgets(per_rule(jobs), budget)
     methods = per_method(jobs, budget["per_method"])
     table = pd.concat([table, methods.drop(columns="slowest_type", errors="ignore")], ignore_index=True)
-    tables.write_csv(out, table)
-    write_table_html(outputs.table_html, table, "Run time per rule, against its budget",
+    tables.write_csv(path, table)
+    write_table_html(out.table_html, table, "Run time per rule, against its budget",
                      f"The wall-clock span, all job seconds, then per rule (slowest first), each beside its budget "
                      f"(config runtime, docs/benchmarks.md); then per method within "
                      f"{', '.join(budget['per_method'])} (budget: seconds per method and room type). The same rows "
-                     f"are in {out.name}.", notes={"share": "share of all job seconds",
+                     f"are in {path.name}.", notes={"share": "share of all job seconds",
                                                    "over_budget": "job seconds above the budget"})
     for row in table.head(8).itertuples(index=False):
         log.info("  %-48s %4d jobs %8.1f s (budget %s)", row.rule, row.jobs, row.job_seconds, row.budget_seconds)

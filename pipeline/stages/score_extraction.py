@@ -11,10 +11,10 @@ from ..stage import Files
 log = logging.getLogger("planit.score")
 
 
-def run(config: dict, inp: Files, outputs: Files) -> dict:
+def run(config: dict, inp: Files, out: Files) -> dict:
     """Counts shard by shard (shard k's rooms, edges and ground truth), then the scores: memory does not grow
     with the corpus."""
-    nodes, edges, ground_truth, out = inp.nodes, inp.edges, inp.ground_truth, outputs.metrics
+    nodes, edges, ground_truth = inp.nodes, inp.edges, inp.ground_truth
     if not len(nodes) == len(edges) == len(ground_truth):
         raise tables.TableError(f"score: {len(nodes)} node, {len(edges)} edge and {len(ground_truth)} ground-truth "
                                 "tables: one of each per shard")
@@ -25,6 +25,6 @@ def run(config: dict, inp: Files, outputs: Files) -> dict:
         gt = tables.read(g, "ground_truth", filters=[("room_id", "in", ids)] if ids else None).to_pandas()
         counts += extraction_counts(node_df, tables.read(e, "edges").to_pandas(), gt[gt["room_id"].isin(ids)])
     metrics = extraction_scores(counts)
-    tables.write_json(out, metrics)
+    tables.write_json(out.metrics, metrics)
     log.info("scores: %s", metrics)
     return metrics
