@@ -16,6 +16,7 @@ from __future__ import annotations
 import platform
 import statistics
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +42,7 @@ def bookshelf(shelves=5, width=0.8, depth=0.35, height=1.8, panel=0.02) -> meshe
     return meshes.combine(side + flat)
 
 
-def timed(a, b, intersector, pen: dict, repeat: int) -> tuple[float, float]:
+def timed(a, b, intersector, pen: collision.Measure, repeat: int) -> tuple[float, float]:
     """``(depth m, median ms)`` of ``mesh_penetration`` over ``repeat`` runs."""
     times = []
     for _ in range(repeat):
@@ -96,8 +97,9 @@ def main() -> None:
     args = ap.parse_args()
     cfg, embree = config_mod.validate({}), intersector_class("embree")
     limit = cfg["evaluate"]["collision"]["max_penetration"]
-    settings = {"evaluate": cfg["evaluate"]["collision"]["penetration"],
-                "instantiate": cfg["instantiate"]["checks"]["penetration"], "filter": cfg["filter"]["penetration"]}
+    settings = {name: collision.Measure(**section) for name, section in (
+        ("evaluate", cfg["evaluate"]["collision"]["penetration"]), ("instantiate", cfg["instantiate"]["checks"]["penetration"]),
+        ("filter", cfg["filter"]["penetration"]))}
     shelf = bookshelf()
     collision.mesh_penetration(shelf, (shelf[0] + 0.1, shelf[1]), embree, settings["evaluate"])  # Embree's device
     result = {"machine": platform.processor() or platform.machine(), "repeat": args.repeat, "limit_m": limit}
@@ -106,7 +108,7 @@ def main() -> None:
         for label, a, b in pairs:
             row = {"pair": label}
             for name, pen in settings.items():
-                for when, p in (("before", {**pen, "surface_spacing": None}), ("after", pen)):
+                for when, p in (("before", replace(pen, surface_spacing=None)), ("after", pen)):
                     row[f"{name}_{when}_m"], row[f"{name}_{when}_ms"] = timed(a, b, embree, p, args.repeat)
             rows.append(row)
         result[group] = summary(pd.DataFrame(rows), limit, list(settings))

@@ -31,6 +31,7 @@ from pipeline import config as config_mod, tables
 from pipeline.evaluation import functional as functional_checks, physical
 from pipeline.evaluation.distributions import category_kl
 from pipeline.evaluation.evaluate import off_axis_gap, off_axis_shares
+from pipeline.geometry.collision import CollisionTest
 from pipeline.geometry.frames import turn_error
 from pipeline.learning import checkpoint
 from pipeline.methods.corpus import load_corpus
@@ -95,7 +96,7 @@ def probe_networks(cfg, room_type: str, saved, probes: int, checker) -> dict:
             "orientation_within_15deg_face_away_rule": round(rule_hits / max(n, 1), 3), "orientation_probes": n}
 
 
-def evaluation_collisions(room, parent: dict, checker, ev: dict):
+def evaluation_collisions(room, parent: dict, checker, ev: CollisionTest):
     """``(n,)`` bool: the placed room's objects the evaluation's own test finds colliding."""
     return physical.colliding(room, [parent.get(i) for i in room.object_ids], checker.meshes_of(room), ev)
 
@@ -144,7 +145,8 @@ def main() -> None:
                                      args.scenes * draws)
     proposer = instantiate.make_proposer(args.location, saved, cfg["instantiate"], cfg["extract"],
                                          instantiate.pose_rules(cfg, ctx.corpus))
-    rows, rooms, colliding, ev = [], [], 0, {**cfg["evaluate"]["collision"], "intersector": ctx.checker.intersector}
+    rows, rooms, colliding, ev = [], [], 0, CollisionTest.of(cfg["evaluate"]["collision"]["penetration"],
+                                                     cfg["evaluate"]["collision"]["max_penetration"], ctx.checker.intersector)
     fn_cfg, sym = cfg["evaluate"]["functional"], ctx.checker.symmetry
     learned, functional = functional_checks.learn_checks(ctx.corpus.training(), fn_cfg, sym), []
     for plan in plans:

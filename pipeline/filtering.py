@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from .geometry import boxes
-from .geometry.collision import deepest_penetration
+from .geometry.collision import CollisionTest, deepest_penetration
 from .geometry.polygon import poke_out, wall_loop
 from .room import room_slices
 
@@ -73,7 +73,8 @@ def _placement_reasons(room, objs: dict, cfg: dict) -> list[tuple[str, str]]:
     depth = boxes.penetration_depths(b)
     related = (parents[:, None] == ids[None, :]) | (parents[None, :] == ids[:, None])
     depth[related] = 0.0
-    worst = deepest_penetration(depth, objs, cfg, exact=True)  # its depth is reported
+    test = CollisionTest.of(cfg["penetration"], cfg["max_penetration"], cfg.get("intersector"))
+    worst = deepest_penetration(depth, objs, test, exact=True)  # its depth is reported
     if worst is not None:
         i, j, d, measure = worst
         out.append(("interpenetration", f"{ids[i]} and {ids[j]} interpenetrate by {d:.2f} m ({measure})"))

@@ -1,6 +1,7 @@
 """Interpenetration measured on meshes (geometry/collision.py) and used by the filter: hand-built meshes and the
 real 3D-FRONT furniture sample."""
 import math
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -16,7 +17,7 @@ from conftest import Room, l_sofa_mesh, shared_data, table_mesh
 
 EMBREE = intersector_class("embree")
 _C = config.validate({"filter": {"min_category_rooms": 1}})
-PEN = _C["filter"]["penetration"]
+PEN = collision.Measure(**_C["filter"]["penetration"])
 
 
 def placed(mesh, xy, yaw_deg=0.0, z=0.0):
@@ -27,7 +28,7 @@ def placed(mesh, xy, yaw_deg=0.0, z=0.0):
 def test_box_meshes_penetrate_by_their_overlap_within_a_pitch(overlap):
     a = placed(meshes.box((1.0, 1.0, 1.0), (0, 0, 0.5)), (0.0, 0.0))
     b = placed(meshes.box((1.0, 1.0, 1.0), (0, 0, 0.5)), (1.0 - overlap, 0.3))
-    pitch = max(min(1.0 / PEN["resolution"], overlap / 6), PEN["min_pitch"])
+    pitch = max(min(1.0 / PEN.resolution, overlap / 6), PEN.min_pitch)
     assert collision.mesh_penetration(a, b, EMBREE, PEN) == pytest.approx(overlap, abs=pitch)
 
 
@@ -49,7 +50,7 @@ def _filter(room: Room, measure: str):
     rooms = pd.DataFrame([dict(vars(room.row()), shard=0)])
     objs = room.objects_df()
     cfg = {**_C["filter"], "floor_contact": _C["floor_contact"], "intersector": EMBREE,
-           "penetration": {**PEN, "measure": measure}}
+           "penetration": {**_C["filter"]["penetration"], "measure": measure}}
     rep = filter_rooms(rooms, room.walls(), objs, cfg, category_room_counts(rooms, objs), room.models)
     return rep.iloc[0]
 
@@ -145,7 +146,7 @@ def test_a_pair_the_coarse_per_attempt_grid_clears_is_measured_again_the_evaluat
     assert check_collision(room, 1, set(), Checker(r.models, set(), {}, ext, EMBREE, {**checks, "confirm": None})) is None
     hit = check_collision(room, 1, set(), Checker(r.models, set(), {}, ext, EMBREE, checks))
     assert hit is not None and hit[0] == 0 and hit[1] == pytest.approx(0.015, abs=0.0065)  # one pitch: 6 mm here
-    ev = {**cfg["evaluate"]["collision"], "intersector": EMBREE}
+    ev = collision.CollisionTest.of(cfg["evaluate"]["collision"]["penetration"], cfg["evaluate"]["collision"]["max_penetration"], EMBREE)
     assert physical.colliding(room, [None, None], [r.models[m] for m in room.model_ids], ev).all()
 
 
@@ -165,13 +166,13 @@ def shifted(mesh, offset):
 
 SPACING = (1.8 - 0.02) / 6  # between the 5-shelf bookcase's panels
 LIMIT = _C["evaluate"]["collision"]["max_penetration"]  # 1 cm: what the evaluation and the placement checks allow
-SETTINGS = {"evaluate": _C["evaluate"]["collision"]["penetration"], "instantiate": _C["instantiate"]["checks"]["penetration"],
-            "filter": PEN}
+SETTINGS = {"evaluate": collision.Measure(**_C["evaluate"]["collision"]["penetration"]),
+            "instantiate": collision.Measure(**_C["instantiate"]["checks"]["penetration"]), "filter": PEN}
 
 
 def _grid_only(pen):
     """The measure before issue 27: the grid over the boxes' overlap alone."""
-    return {**pen, "surface_spacing": None}
+    return replace(pen, surface_spacing=None)
 
 
 @pytest.mark.parametrize("setting", ["evaluate", "instantiate"])
@@ -189,9 +190,9 @@ def test_bookshelves_whose_panels_interleave_penetrate_by_a_panel_the_grid_alone
     pen = SETTINGS[setting]
     a, b = bookshelf(), shifted(bookshelf(shelves), offset)
     lo, hi = collision.box_overlap(a[0].min(0), a[0].max(0), b[0].min(0), b[0].max(0))
-    assert collision.grid(lo, hi, pen["resolution"], pen["min_pitch"], pen["max_cells"])[1] > 0.04
+    assert collision.grid(lo, hi, pen.resolution, pen.min_pitch, pen.max_cells)[1] > 0.04
     assert collision.mesh_penetration(a, b, EMBREE, _grid_only(pen)) < LIMIT
-    assert collision.mesh_penetration(a, b, EMBREE, pen) == pytest.approx(0.02, abs=pen["min_pitch"])
+    assert collision.mesh_penetration(a, b, EMBREE, pen) == pytest.approx(0.02, abs=pen.min_pitch)
 
 
 def test_bookshelves_apart_or_one_inside_the_others_compartment_do_not_penetrate():
@@ -222,7 +223,7 @@ def test_interleaved_bookshelves_collide_for_the_placement_checks_the_filter_and
         r = room()
         room_in, ext = r.room_input(), {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
         placed = check_collision(room_in, 4, set(), Checker(r.models, set(), {}, ext, EMBREE, checks_config(cfg)))
-        ev = {**cfg["evaluate"]["collision"], "intersector": EMBREE}
+        ev = collision.CollisionTest.of(cfg["evaluate"]["collision"]["penetration"], LIMIT, EMBREE)
         evaluated = physical.colliding(room_in, [None] * 5, [r.models[m] for m in room_in.model_ids], ev)
         rooms = pd.DataFrame([dict(vars(r.row()), shard=0)])
         flt = {**cfg["filter"], "floor_contact": cfg["floor_contact"], "intersector": EMBREE, "max_penetration": LIMIT}

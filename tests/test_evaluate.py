@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from pipeline.evaluation import distributions, physical, render, walkability
+from pipeline.geometry.collision import CollisionTest
 from pipeline.geometry.raycast import intersector_class
 from pipeline.stage import Files
 
@@ -18,8 +19,7 @@ SQUARE = [(0, 0), (4, 0), (4, 4), (0, 4)]
 
 def _collision_cfg(measure="mesh"):
     ev = default_config()["evaluate"]["collision"]
-    return {"max_penetration": ev["max_penetration"], "penetration": {**ev["penetration"], "measure": measure},
-            "intersector": intersector_class("embree")}
+    return CollisionTest.of({**ev["penetration"], "measure": measure}, ev["max_penetration"], intersector_class("embree"))
 
 
 def _colliding(room: Room, measure="mesh"):

@@ -3,22 +3,22 @@ objects out of bounds (ThreedFront toolkit's test: the footprint eroded by a mar
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
 
 import numpy as np
 
 from ..geometry import boxes
-from ..geometry.collision import penetrating_pairs
+from ..geometry.collision import CollisionTest, penetrating_pairs
 from ..geometry.meshes import Mesh
 from ..geometry.polygon import outside_area
 from ..room import RoomInput
 
 
-def colliding(room: RoomInput, parents: Sequence[str | None], meshes: Sequence[Mesh | None], cfg: dict[str, Any]) -> np.ndarray:
-    """``(n,)`` bool: objects penetrating another deeper than ``cfg['max_penetration']``, ignoring support pairs.
+def colliding(room: RoomInput, parents: Sequence[str | None], meshes: Sequence[Mesh | None],
+              test: CollisionTest) -> np.ndarray:
+    """``(n,)`` bool: objects penetrating another deeper than ``test.limit``, ignoring support pairs.
 
     ``parents``: each object's support parent id (or None); ``meshes``: each object's ``(vertices, faces)`` or None
-    (measured as its box); ``cfg``: ``max_penetration``, ``penetration`` (as filter.penetration) and ``intersector``.
+    (measured as its box); ``test``: the evaluation's (``evaluate.collision``, :meth:`CollisionTest.of`).
     """
     n = len(room.object_ids)
     out = np.zeros(n, bool)
@@ -28,7 +28,7 @@ def colliding(room: RoomInput, parents: Sequence[str | None], meshes: Sequence[M
     par = np.asarray([p if isinstance(p, str) else None for p in parents], dtype=object)
     depth = boxes.penetration_depths(room.boxes)
     depth[(par[:, None] == ids[None, :]) | (par[None, :] == ids[:, None])] = 0.0
-    for i, j, _, _ in penetrating_pairs(depth, {"meshes": list(meshes), "poses": room.poses}, cfg):
+    for i, j, _, _ in penetrating_pairs(depth, {"meshes": list(meshes), "poses": room.poses}, test):
         out[i] = out[j] = True
     return out
 

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from ..geometry.collision import CollisionTest
 from ..geometry.raycast import intersector_class
 from ..log import progress
 from ..seeding import rng_for
@@ -22,8 +23,8 @@ def scene_rows(rs: RoomSet, meshes: dict[str, Any], box_models: set[str], train_
                index: dict[str, int], config: dict[str, Any]) -> list[dict[str, Any]]:
     """One ``eval_scenes`` row per room of a set."""
     ev = config["evaluate"]
-    ccfg = {"max_penetration": ev["collision"]["max_penetration"], "penetration": ev["collision"]["penetration"],
-            "intersector": intersector_class(config["extract"]["backend"])}
+    ccfg = CollisionTest.of(ev["collision"]["penetration"], ev["collision"]["max_penetration"],
+                            intersector_class(config["extract"]["backend"]))
     records = rs.scenes.set_index("scene_id") if rs.scenes is not None else None
     rows = []
     for room, parents in progress(list(zip(rs.rooms, rs.parents)), desc=f"scoring {rs.name}"):

@@ -17,7 +17,8 @@ grids (cubes of ``surface_window`` at ``min_pitch``); the depth is the larger of
 """
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
 from typing import Any, cast
 
 import numpy as np
@@ -29,6 +30,42 @@ from .raycast import RoomScene
 # skewed so that rays do not graze the axis-aligned faces and edges furniture is made of
 DIRECTIONS = np.array([[1.0, 0.137, 0.071], [-0.113, 1.0, 0.059], [0.067, -0.091, 1.0]])
 DIRECTIONS /= np.linalg.norm(DIRECTIONS, axis=1, keepdims=True)
+
+
+@dataclass(frozen=True)
+class Measure:
+    """How a pair of meshes is measured: one ``penetration`` section of the config (``filter``,
+    ``instantiate.checks``, ``evaluate.collision``; keys and units in the schema), built once where a stage reads it.
+    ``measure``: ``mesh`` or ``box``; the sampling grid (``resolution``, ``min_pitch`` m, ``max_cells``) and the
+    surface screen (``surface_spacing`` m, None: no screen; ``max_surface_points``, ``surface_window`` m,
+    ``max_windows``)."""
+
+    measure: str
+    resolution: int
+    min_pitch: float
+    max_cells: int
+    surface_spacing: float | None
+    max_surface_points: int
+    surface_window: float
+    max_windows: int
+
+
+@dataclass(frozen=True)
+class CollisionTest:
+    """Which pairs penetrate: deeper than ``limit`` (m) by ``measure``, each mesh pair it clears measured again by
+    ``confirm`` where given (so a coarse measure may screen but never clear a pair the finer one finds); ``intersector``:
+    the ray backend's class (None: every pair measured as boxes, e.g. a filter run without meshes)."""
+
+    measure: Measure
+    limit: float
+    intersector: type[Any] | None
+    confirm: Measure | None = None
+
+    @classmethod
+    def of(cls, penetration: Mapping[str, Any], limit: float, intersector: type[Any] | None,
+           confirm: Mapping[str, Any] | None = None) -> "CollisionTest":
+        """From the config's ``penetration`` section(s) and limit."""
+        return cls(Measure(**penetration), float(limit), intersector, None if confirm is None else Measure(**confirm))
 
 
 def box_overlap(lo_a: np.ndarray, hi_a: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -89,26 +126,25 @@ def thickness(mask: np.ndarray, pitch: float) -> float:
 
 
 def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], intersector: type[Any],
-                     cfg: dict[str, Any], enough: float = np.inf) -> float:
-    """Penetration depth (m) of two meshes in world coordinates, each ``(vertices (n, 3), faces (m, 3))``; ``cfg``:
-    ``resolution``, ``min_pitch`` (m) and ``max_cells`` of the sampling grid; ``surface_spacing`` (m; null: no
-    screen), ``max_surface_points``, ``surface_window`` (m) and ``max_windows`` of the surface screen
-    (:func:`surface_depth`), which runs where the grid finds less than two pitches: a region the grid misses is
-    thinner than that (at most sqrt 3 pitches), so where it finds more the screen cannot find deeper. ``enough``
+                     m: Measure, enough: float = np.inf) -> float:
+    """Penetration depth (m) of two meshes in world coordinates, each ``(vertices (n, 3), faces (m, 3))``, by the
+    grid and the surface screen of ``m`` (:func:`surface_depth`), which runs where the grid finds less than two
+    pitches: a region the grid misses is thinner than that (at most sqrt 3 pitches), so where it finds more the
+    screen cannot find deeper. ``enough``
     (m): a caller that asks only whether the depth exceeds it gets the grid's depth, without the screen, once that
     already does (a lower bound above ``enough``, never a different verdict)."""
     lo, hi = box_overlap(a[0].min(0), a[0].max(0), b[0].min(0), b[0].max(0))
     if np.any(hi <= lo):
         return 0.0
     scenes = mesh_scene(a, intersector), mesh_scene(b, intersector)
-    cells, pitch = grid(lo, hi, cfg["resolution"], cfg["min_pitch"], cfg["max_cells"])
+    cells, pitch = grid(lo, hi, m.resolution, m.min_pitch, m.max_cells)
     points = cells.reshape(-1, 3)
     both = inside_scene(scenes[0], points)
     both[both] = inside_scene(scenes[1], points[both])  # only the points inside the first mesh can be in both
     depth = thickness(both.reshape(cells.shape[:3]), pitch)
-    if cfg["surface_spacing"] is None or depth >= 2 * pitch or depth > enough:
+    if m.surface_spacing is None or depth >= 2 * pitch or depth > enough:
         return depth
-    return max(depth, surface_depth((a, b), scenes, lo, hi, cfg))
+    return max(depth, surface_depth((a, b), scenes, lo, hi, m))
 
 
 def surface_points(mesh: tuple[np.ndarray, np.ndarray], lo: np.ndarray, hi: np.ndarray, spacing: float,
@@ -143,7 +179,7 @@ def surface_points(mesh: tuple[np.ndarray, np.ndarray], lo: np.ndarray, hi: np.n
 
 
 def surface_depth(meshes: tuple[Mesh, Mesh], scenes: tuple[RoomScene, RoomScene], lo: np.ndarray, hi: np.ndarray,
-                  cfg: dict[str, Any]) -> float:
+                  m: Measure) -> float:
     """Thickness (m) of the region inside both meshes where their surfaces cross: the points of each mesh's surface
     in the overlap ``[lo, hi]`` (:func:`surface_points`, seeded) that lie inside the other mesh bound that region, so
     :func:`window_depth` measures it around them; 0 where no surface point is inside the other mesh. The points lie
@@ -152,26 +188,25 @@ def surface_depth(meshes: tuple[Mesh, Mesh], scenes: tuple[RoomScene, RoomScene]
     rng = np.random.default_rng(0)
     found = []
     for mesh, other in zip(meshes, scenes[::-1]):
-        points = surface_points(mesh, lo, hi, cfg["surface_spacing"], cfg["max_surface_points"], cfg["min_pitch"] / 10,
-                                rng)
+        points = surface_points(mesh, lo, hi, cast(float, m.surface_spacing), m.max_surface_points, m.min_pitch / 10, rng)
         found.append(points[inside_scene(other, points)])
     seeds = np.concatenate(found)
-    return window_depth(scenes, seeds, lo, hi, cfg) if len(seeds) else 0.0
+    return window_depth(scenes, seeds, lo, hi, m) if len(seeds) else 0.0
 
 
 def window_depth(scenes: tuple[RoomScene, RoomScene], seeds: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                 cfg: dict[str, Any]) -> float:
+                 m: Measure) -> float:
     """:func:`thickness` of the region inside both meshes in cubes of side ``surface_window`` (m) at pitch
     ``min_pitch``, each centred on one of the points ``seeds (n, 3)`` in the overlap ``[lo, hi]``: one per
     window-sized block holding seeds, at most ``max_windows`` spread over the blocks' sorted order. The cubes'
     cells lie on one lattice, each tested once; those centred outside ``[lo, hi]`` are outside untested."""
-    pitch = cfg["min_pitch"]
-    side = max(2, int(round(cfg["surface_window"] / pitch)))
+    pitch = m.min_pitch
+    side = max(2, int(round(m.surface_window / pitch)))
     dims = np.ceil((hi - lo) / pitch).astype(np.int64) + 2 * side + 1
     cell = np.floor((seeds - lo) / pitch).astype(np.int64) + side  # >= side: a cube's cells have no negative index
     _, first = np.unique(np.ravel_multi_index((cell // side).T, dims), return_index=True)
-    if len(first) > cfg["max_windows"]:
-        first = first[np.linspace(0, len(first) - 1, cfg["max_windows"]).astype(np.int64)]
+    if len(first) > m.max_windows:
+        first = first[np.linspace(0, len(first) - 1, m.max_windows).astype(np.int64)]
     offsets = np.stack(np.meshgrid(*[np.arange(side) - side // 2] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
     cells = np.ravel_multi_index((cell[first][:, None, :] + offsets).reshape(-1, 3).T, dims)  # (windows * side**3,)
     keys, back = np.unique(cells, return_inverse=True)
@@ -184,47 +219,43 @@ def window_depth(scenes: tuple[RoomScene, RoomScene], seeds: np.ndarray, lo: np.
     return thickness(np.pad(windows, ((0, 0), (1, 1), (1, 1), (1, 1))).reshape(-1, side + 2, side + 2), pitch)
 
 
-def penetrating_pairs(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any],
+def penetrating_pairs(box_depth: np.ndarray, objs: dict[str, Any], test: CollisionTest,
                       exact: bool = False) -> Iterator[tuple[int, int, float, str]]:
-    """Pairs ``(i, j, depth, measure)``, deepest box overlap first, that penetrate deeper than ``max_penetration``:
-    measured on the meshes where both objects have one (``penetration.measure: mesh``), else on the boxes.
-
-    ``cfg['confirm']`` (optional, a finer ``penetration``): a mesh pair the first grid clears is measured again on
-    this one, so a coarse grid may screen but never clear a pair that the finer measure finds penetrating (the
-    depth is accurate to one pitch only). ``exact``: each pair's depth measured in full; else a mesh pair's depth is
-    a lower bound above ``max_penetration`` where the coarse grid alone shows it penetrating (the same pairs)."""
-    pen, limit = cfg["penetration"], cfg["max_penetration"]
-    i, j = np.nonzero(np.triu(box_depth > limit, 1))
+    """Pairs ``(i, j, depth, measure)``, deepest box overlap first, that penetrate deeper than ``test.limit``:
+    measured on the meshes where both objects have one (``measure: mesh``), else on the boxes; a mesh pair the first
+    measure clears is measured again by ``test.confirm`` where given (the depth is accurate to one pitch only).
+    ``exact``: each pair's depth measured in full; else a mesh pair's depth is a lower bound above the limit where the
+    coarse grid alone shows it penetrating (the same pairs)."""
+    i, j = np.nonzero(np.triu(box_depth > test.limit, 1))
     for k in np.argsort(-box_depth[i, j], kind="stable"):
         a, b = int(i[k]), int(j[k])
         ma, mb = objs["meshes"][a], objs["meshes"][b]
-        if pen["measure"] == "box" or ma is None or mb is None:
+        if test.measure.measure == "box" or test.intersector is None or ma is None or mb is None:
             yield a, b, float(box_depth[a, b]), "boxes"
             continue
-        d = _mesh_depth(world_mesh(ma, objs["poses"][a]), world_mesh(mb, objs["poses"][b]), float(box_depth[a, b]), cfg,
-                        np.inf if exact else limit)
-        if d > limit:
+        d = _mesh_depth(world_mesh(ma, objs["poses"][a]), world_mesh(mb, objs["poses"][b]), float(box_depth[a, b]), test,
+                        np.inf if exact else test.limit)
+        if d > test.limit:
             yield a, b, d, "meshes"
 
 
 def _mesh_depth(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], box_depth: float,
-                cfg: dict[str, Any], enough: float) -> float:
-    """Two world meshes' penetration on ``cfg['penetration']``'s grid, measured again on ``cfg['confirm']``'s where
-    the first finds at most ``max_penetration`` (``confirm.measure: box`` takes the boxes' depth instead); each
-    measure stops once past ``enough`` (:func:`mesh_penetration`)."""
-    d = mesh_penetration(a, b, cfg["intersector"], cfg["penetration"], enough)
-    confirm = cfg.get("confirm")
-    if confirm is None or d > cfg["max_penetration"]:
+                test: CollisionTest, enough: float) -> float:
+    """Two world meshes' penetration by ``test.measure``, measured again by ``test.confirm`` where the first finds
+    at most the limit (a ``box`` confirm takes the boxes' depth instead); each measure stops once past ``enough``
+    (:func:`mesh_penetration`)."""
+    d = mesh_penetration(a, b, cast(type, test.intersector), test.measure, enough)
+    if test.confirm is None or d > test.limit:
         return d
-    if confirm["measure"] == "box":
+    if test.confirm.measure == "box":
         return box_depth
-    return mesh_penetration(a, b, cfg["intersector"], confirm, enough)
+    return mesh_penetration(a, b, cast(type, test.intersector), test.confirm, enough)
 
 
-def deepest_penetration(box_depth: np.ndarray, objs: dict[str, Any], cfg: dict[str, Any],
+def deepest_penetration(box_depth: np.ndarray, objs: dict[str, Any], test: CollisionTest,
                         exact: bool = False) -> tuple[int, int, float, str] | None:
     """The first of :func:`penetrating_pairs` (None if no pair penetrates)."""
-    return next(penetrating_pairs(box_depth, objs, cfg, exact), None)
+    return next(penetrating_pairs(box_depth, objs, test, exact), None)
 
 
 def world_mesh(mesh: tuple[np.ndarray, np.ndarray], pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

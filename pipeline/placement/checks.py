@@ -5,6 +5,7 @@ graph is comparable with its plan."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import cast
 
 import numpy as np
@@ -12,7 +13,7 @@ import shapely
 
 from ..extraction import extract_room
 from ..geometry import boxes
-from ..geometry.collision import deepest_penetration
+from ..geometry.collision import CollisionTest, deepest_penetration
 from ..geometry.polygon import door_zones, outside_area
 from ..room import RoomInput
 from .plan import PlanEdge
@@ -58,6 +59,11 @@ class Checker:
     support_floor: dict = field(default_factory=dict)  # category -> learned lower min_support (placement/support.py)
     wall_bound: frozenset = frozenset()  # categories whose planned wall adjacency is never broken (placement/walls.py)
     weighted: bool = False  # an object's relation cost weighs each edge by its plan weight (instantiate.weighted_relations)
+
+    @cached_property
+    def collision_test(self) -> CollisionTest:
+        """The ``penetration`` measure at the ``collision`` limit, confirmed by ``confirm`` where given."""
+        return CollisionTest.of(self.cfg["penetration"], self.cfg["collision"], self.intersector, self.cfg.get("confirm"))
 
     def min_support(self, category: str) -> float:
         """The share of its footprint an object of ``category`` must keep over its support."""
@@ -110,9 +116,7 @@ def collision(room: RoomInput, k: int, related: set[int], checker: Checker) -> t
     row[list(related)] = 0.0
     depth[k], depth[:, k] = row, row
     objs = {"meshes": checker.meshes_of(room), "poses": room.poses}
-    cfg = {"penetration": checker.cfg["penetration"], "max_penetration": checker.cfg["collision"],
-           "intersector": checker.intersector, "confirm": checker.cfg.get("confirm")}
-    hit = deepest_penetration(depth, objs, cfg)
+    hit = deepest_penetration(depth, objs, checker.collision_test)
     return None if hit is None else (hit[1] if hit[0] == k else hit[0], hit[2])
 
 
