@@ -21,6 +21,7 @@ import json
 import platform
 import statistics
 import zlib
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -135,7 +136,7 @@ def main() -> None:
                             instantiate.checkpoint_kind(args.location))
     ctx = load_context(cfg, corpus_of(cfg, args.room_type), cfg["instantiate"]["wall_bound_share"])  # as PlanIT's search
     if args.no_confirm:
-        ctx.checker.cfg["confirm"] = None
+        ctx.checker = replace(ctx.checker, cfg={**ctx.checker.cfg, "confirm": None})  # a fresh collision_test
     variant = {**cfg["instantiate"]["variants"]["planit"], "location": args.location, "graphs": args.graphs}
     graphs = Path("results/graph_model") / args.room_type / "planit" / "sampled"
     if args.graphs == "heldout":

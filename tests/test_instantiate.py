@@ -647,6 +647,17 @@ def test_a_supported_object_is_offered_the_part_of_its_support_no_sibling_covers
     assert np.array_equal(s.free_top(1, np.array([0.15, 0.1])), lamp_top)  # nothing stands on the lamp
 
 
+def _at_plain_support(r: Room):
+    """The search settings, checker and empty room for a catalog room ``r``, the support check at PlanIT's 0.9 with no
+    learned floor."""
+    cfg = default_config()
+    checks = {**cfg["instantiate"]["checks"], "min_support": 0.9,
+              "learned_support": {**cfg["instantiate"]["checks"]["learned_support"], "enabled": False}}
+    checker = Checker(r.models, set(r.models), {}, {"floor_contact": cfg["floor_contact"], **cfg["extract"]},
+                      intersector_class("embree"), checks)
+    return {**cfg["instantiate"], "checks": checks}, checker, with_objects(r.room_input(), [])
+
+
 @pytest.mark.parametrize("widths, fitting", [((1.4, 1.5, 0.8, 1.6), {0.8}), ((1.4, 1.5), {1.4, 1.5})])
 def test_an_object_planned_on_a_placed_support_takes_an_instance_that_can_stand_on_it(widths, fitting):
     """AI2-THOR living rooms left out 4 of their 5 televisions planned on a side table, each refused as overhanging
@@ -659,12 +670,7 @@ def test_an_object_planned_on_a_placed_support_takes_an_instance_that_can_stand_
     r.add("stand", "tv_stand", (0.9, 0.4, 0.5), (0.6, 0.4))
     for k, w in enumerate(widths):
         r.add(f"tv{k}", "tv", (w, 0.1, 0.6), (1.5 + k * 0.5, 2.5), z=0.5, parent="x")
-    cfg = default_config()
-    ic = {**cfg["instantiate"], "checks": {**cfg["instantiate"]["checks"], "min_support": 0.9,
-                                           "learned_support": {**cfg["instantiate"]["checks"]["learned_support"], "enabled": False}}}
-    checker = Checker(r.models, set(r.models), {}, {"floor_contact": cfg["floor_contact"], **cfg["extract"]},
-                      intersector_class("embree"), ic["checks"])
-    room = with_objects(r.room_input(), [])
+    ic, checker, room = _at_plain_support(r)
     plan = ScenePlan("s0", "r0", "living", ["st", "tv"], ["tv_stand", "tv"], ["left-right"] * 2, [1, 2], [None, "st"],
                      ["none", "none"], [PlanEdge("wall_0", "st", "spatial", "front", "adjacent"),
                                         PlanEdge("st", "tv", "support", None, None)])
@@ -694,12 +700,7 @@ def test_a_support_takes_an_instance_that_what_it_is_planned_to_hold_can_stand_o
     for k, w in enumerate((1.1, 1.2)):
         r.add(f"tv{k}", "tv", (w, 0.2, 0.6), (1.0 + k * 1.5, 3.0), z=0.6, parent="x")
     r.add("lamp", "table_lamp", (0.2, 0.2, 0.4), (4.0, 3.0), z=0.6, parent="x")
-    cfg = default_config()
-    ic = {**cfg["instantiate"], "checks": {**cfg["instantiate"]["checks"], "min_support": 0.9,
-                                           "learned_support": {**cfg["instantiate"]["checks"]["learned_support"], "enabled": False}}}
-    checker = Checker(r.models, set(r.models), {}, {"floor_contact": cfg["floor_contact"], **cfg["extract"]},
-                      intersector_class("embree"), ic["checks"])
-    room = with_objects(r.room_input(), [])
+    ic, checker, room = _at_plain_support(r)
 
     def widths(child: str) -> set[float]:
         plan = ScenePlan("s0", "r0", "living", ["st", "on"], ["side_table", child], ["none"] * 2, [1, 2], [None, "st"],

@@ -23,8 +23,8 @@ def scene_rows(rs: RoomSet, meshes: dict[str, Any], box_models: set[str], train_
                index: dict[str, int], config: dict[str, Any]) -> list[dict[str, Any]]:
     """One ``eval_scenes`` row per room of a set."""
     ev = config["evaluate"]
-    ccfg = CollisionTest.of(ev["collision"]["penetration"], ev["collision"]["max_penetration"],
-                            intersector_class(config["extract"]["backend"]))
+    collision_test = CollisionTest.of(ev["collision"]["penetration"], ev["collision"]["max_penetration"],
+                                      intersector_class(config["extract"]["backend"]))
     records = rs.scenes.set_index("scene_id") if rs.scenes is not None else None
     rows = []
     for room, parents in progress(list(zip(rs.rooms, rs.parents)), desc=f"scoring {rs.name}"):
@@ -36,7 +36,7 @@ def scene_rows(rs: RoomSet, meshes: dict[str, Any], box_models: set[str], train_
         rec = records.loc[room.room_id] if records is not None and room.room_id in records.index else None
         rows.append({
             "set": rs.name, "scene_id": room.room_id, "room_type": room.room_type, "objects": len(room.object_ids),
-            "colliding_objects": int(physical.colliding(room, parents, mesh, ccfg).sum()),
+            "colliding_objects": int(physical.colliding(room, parents, mesh, collision_test).sum()),
             "out_of_bounds": int(physical.out_of_bounds(room.outline, room.boxes, ev["out_of_bounds"]["erode"],
                                                         ev["out_of_bounds"]["tolerance"]).sum()),
             "walkable_share": walk["walkable_share"], "reachable": walk["reachable"],

@@ -130,9 +130,8 @@ def mesh_penetration(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.n
     """Penetration depth (m) of two meshes in world coordinates, each ``(vertices (n, 3), faces (m, 3))``, by the
     grid and the surface screen of ``m`` (:func:`surface_depth`), which runs where the grid finds less than two
     pitches: a region the grid misses is thinner than that (at most sqrt 3 pitches), so where it finds more the
-    screen cannot find deeper. ``enough``
-    (m): a caller that asks only whether the depth exceeds it gets the grid's depth, without the screen, once that
-    already does (a lower bound above ``enough``, never a different verdict)."""
+    screen cannot find deeper. ``enough`` (m): a caller that asks only whether the depth exceeds it gets the grid's
+    depth, without the screen, once that already does (a lower bound above ``enough``, never a different verdict)."""
     lo, hi = box_overlap(a[0].min(0), a[0].max(0), b[0].min(0), b[0].max(0))
     if np.any(hi <= lo):
         return 0.0

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import cast
 
 import numpy as np
 import shapely
@@ -96,11 +95,12 @@ def centred_shares(half: np.ndarray, support_half: np.ndarray) -> np.ndarray:
     return out
 
 
-def fits_on(support: np.ndarray, least: float, half: np.ndarray) -> np.ndarray:
-    """``(n,)`` bool: a footprint of each of the half extents ``half (n, >= 2)`` (m), centred on ``support (7,)``'s top
-    and square to it either way, keeps at least ``least`` of its area over it (:func:`centred_shares`): the best any
-    place on the support can do for it turned square."""
-    return cast(np.ndarray, centred_shares(half, np.asarray(support, float)[None, 3:5])[0] >= least - 1e-9)
+def fits_on(half: np.ndarray, support_half: np.ndarray, least: float) -> np.ndarray:
+    """``(n, m)`` bool: a footprint of each of the half extents ``half (m, >= 2)`` (m), centred on a support of each of
+    ``support_half (n, >= 2)`` and square to it either way, keeps at least ``least`` of its area over it
+    (:func:`centred_shares`): the best any place on the support can do for it turned square."""
+    out: np.ndarray = centred_shares(half, support_half) >= least - 1e-9
+    return out
 
 
 def support_share(child: np.ndarray, parent: np.ndarray) -> float:

@@ -57,7 +57,7 @@ class ModelPool:
         that stood on the floor where the category has such (a floor node with planned spatial edges: extraction
         sees no spatial relation of an object hanging above the floor, e.g. an AI2-THOR counter-top slab); ``fits``:
         ``(n, 3)`` half extents -> ``(n,)`` bool, one it accepts where the category has such (an object planned on a
-        placed support: one that can stand on it, :func:`~pipeline.placement.checks.fits_on`)."""
+        placed support: one that can stand on it, ``Search.fits``)."""
         if category not in self.by_cat:
             raise KeyError(f"no training instance of category '{category}'")
         pool = self.by_cat[category]

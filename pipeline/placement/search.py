@@ -39,7 +39,7 @@ from ..geometry.boxes import SIDE_NORMALS, SIDES, footprint_corners, rotation
 from ..geometry.relations import in_footprint
 from ..room import RoomInput, Walls
 from .anchors import Anchor, anchors_of, planned_edges
-from .checks import Checker, centred_shares, check, fits_on
+from .checks import Checker, check, fits_on
 from .layout import add_object, walls_of, with_objects
 from .order import chains
 from .plan import ScenePlan
@@ -209,10 +209,11 @@ class Search:
         ok = np.ones(len(half), bool)
         parent, v = self.plan.parent[k], self.plan.ids[k]
         if parent in self.room.object_ids:
-            ok &= fits_on(self.room.boxes[self.room.object_ids.index(parent)], self.checker.min_support(self.plan.categories[k]), half)
+            support = self.room.boxes[self.room.object_ids.index(parent), 3:5]
+            ok &= fits_on(half, support[None], self.checker.min_support(self.plan.categories[k]))[0]
         sizes, back = np.unique(np.asarray(half, float)[:, :2], axis=0, return_inverse=True)
         for cat in {c for c, p in zip(self.plan.categories, self.plan.parent) if p == v and self.pool.has(c)}:
-            ok &= (centred_shares(self.pool.sizes(cat), sizes) >= self.checker.min_support(cat) - 1e-9).any(1)[back.ravel()]
+            ok &= fits_on(self.pool.sizes(cat), sizes, self.checker.min_support(cat)).any(1)[back.ravel()]
         return ok
 
     def occupied(self, grow: float, room: RoomInput | None = None) -> np.ndarray:
