@@ -20,7 +20,6 @@ from __future__ import annotations
 import json
 import platform
 import statistics
-import zlib
 from dataclasses import replace
 from pathlib import Path
 
@@ -47,6 +46,7 @@ from pipeline.placement.anchors import anchors_of
 from pipeline.placement.layout import wall_frame, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Grid, Request, nearest_wall
+from pipeline.seeding import seed_of
 
 from common import ROOT, arguments, corpus_paths, report, search_flags, search_overrides, search_suffix
 
@@ -55,6 +55,11 @@ def corpus_of(cfg: dict, room_type: str):
     """The kept rooms of a room type as every method reads them (the default run's outputs)."""
     p = corpus_paths(cfg)
     return load_corpus(room_type, {**p, "split": p["splits"] / f"{room_type}.parquet"})
+
+
+def bench_seed(cfg: dict, scene_id: str) -> int:
+    """The seed this bench places scene ``scene_id`` with (``bench/replay_scene.py --bench`` replays it)."""
+    return seed_of(cfg["seed"], "bench", scene_id)
 
 
 def probe_networks(cfg, room_type: str, saved, probes: int, checker) -> dict:
@@ -146,14 +151,14 @@ def main() -> None:
                                      args.scenes * draws)
     proposer = instantiate.make_proposer(args.location, saved, cfg["instantiate"], cfg["extract"],
                                          instantiate.pose_rules(cfg, ctx.corpus))
-    rows, rooms, colliding, ev = [], [], 0, CollisionTest.of(cfg["evaluate"]["collision"]["penetration"],
+    rows, rooms, failing, colliding, ev = [], [], {}, 0, CollisionTest.of(cfg["evaluate"]["collision"]["penetration"],
                                                      cfg["evaluate"]["collision"]["max_penetration"], ctx.checker.intersector)
     fn_cfg, sym = cfg["evaluate"]["functional"], ctx.checker.symmetry
     learned, functional = functional_checks.learn_checks(ctx.corpus.training(), fn_cfg, sym), []
     for plan in plans:
         if len(rooms) >= args.scenes:
             break
-        seed = zlib.crc32(f"{cfg['seed']}/bench/{plan.scene_id}".encode())
+        seed = bench_seed(cfg, plan.scene_id)
         out, walls = instantiate.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
         metrics = scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker, out.dropped, out.accepted)
         rows.append((out.ok, out.seconds, metrics["consistency"], out.rejections, len(out.relaxed),
@@ -161,6 +166,7 @@ def main() -> None:
         if out.status in tables.SCORED:
             rooms.append(out.room)
             functional.append(functional_checks.score_room(out.room, learned, fn_cfg, sym))
+            failing[plan.scene_id] = sorted(k for k, v in functional[-1].items() if k.startswith("fn:") and v < 1)
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())
     placed = [r for r in rows if r[0]]
     axis = off_axis_shares(rooms, sym, cfg["evaluate"]["off_axis_angle"])
@@ -175,6 +181,7 @@ def main() -> None:
               "mean_consistency_placed": round(float(np.mean([r[2] for r in placed])), 4) if placed else None,
               "plan_loss_placed": plan_loss(pd.Series([r[6] for r in placed])),
               "failed_reasons": [r[8] for r in rows if not r[0]],
+              "failing_checks": {scene: checks for scene, checks in failing.items() if checks},
               "functional_placed": {k: round(float(v), 3) for k, v in
                                     pd.DataFrame(functional).mean().items()} if functional else None,
               **selection(ctx.corpus, plans[:len(rows)], rooms),

@@ -6,7 +6,8 @@ docs/benchmarks.md's issue-40 figures were found (a chair drawn 0.36 m off its d
         --room-type office --method planit --scene 00010 --watch office_chair,monitor
 
 RUN: a run directory (``snakemake --directory RUN``) with the room type's trained layout model and sampled graphs.
-The replayed scene is the generated one when the code and the config are those of its run.
+The replayed scene is the generated one when the code and the config are those of its run; with ``--bench``, the
+one ``bench/instantiate.py`` placed (whose JSON lists each placed scene's failing functional checks).
 """
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ from pipeline.placement import proposers
 from pipeline.seeding import seed_of
 
 sys.path.insert(0, str(Path(__file__).parent))
-from instantiate import corpus_of  # noqa: E402  (bench/instantiate.py: the run's corpus of one room type)
+from instantiate import bench_seed, corpus_of  # noqa: E402  (bench/instantiate.py: the run's corpus of one room type)
 
 WRAPPERS = (proposers.FaceAnchor, proposers.BackToWall, proposers.FacingPartner, proposers.Centred)
 
@@ -51,6 +52,7 @@ def main() -> None:
     ap.add_argument("--method", choices=["planit", "planit_prior"], default="planit")
     ap.add_argument("--scene", required=True, help="the generated scene id's numeric end, e.g. 00010")
     ap.add_argument("--watch", required=True, help="comma-separated categories whose draws are logged")
+    ap.add_argument("--bench", action="store_true", help="the seed bench/instantiate.py gives the scene, not the run's")
     ap.add_argument("--config", type=Path, default=Path(__file__).parents[1] / "config/config.yaml")
     args = ap.parse_args()
     torch.set_num_threads(1)
@@ -66,8 +68,8 @@ def main() -> None:
     for cls in WRAPPERS:
         logged(cls, set(args.watch.split(",")))
     proposer = inst.make_proposer(location, saved, cfg["instantiate"], cfg["extract"], inst.pose_rules(cfg, ctx.corpus))
-    out, _ = inst.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed_of(cfg["seed"], args.method,
-                                                                                        plan.scene_id))
+    seed = bench_seed(cfg, plan.scene_id) if args.bench else seed_of(cfg["seed"], args.method, plan.scene_id)
+    out, _ = inst.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
     boxes = out.room.boxes.reshape(-1, 7)
     for k, category in enumerate(out.room.categories):
         if category in args.watch.split(","):
