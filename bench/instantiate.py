@@ -149,8 +149,9 @@ def main() -> None:
     draws = cfg["instantiate"]["graph_draws"] if args.graphs == "sampled" else 1
     plans = instantiate.select_plans(cfg, variant, ctx.corpus, graphs / "nodes.parquet", graphs / "edges.parquet",
                                      args.scenes * draws)
-    proposer = instantiate.make_proposer(args.location, saved, cfg["instantiate"], cfg["extract"],
-                                         instantiate.pose_rules(cfg, ctx.corpus))
+    rules = instantiate.pose_rules(cfg, ctx.corpus)
+    proposer = instantiate.make_proposer(args.location, saved, cfg["instantiate"], cfg["extract"], rules)
+    ctx = instantiate.ordered_by_partners(ctx, rules, cfg["instantiate"])
     rows, rooms, failing, colliding, ev = [], [], {}, 0, CollisionTest.of(cfg["evaluate"]["collision"]["penetration"],
                                                      cfg["evaluate"]["collision"]["max_penetration"], ctx.checker.intersector)
     fn_cfg, sym = cfg["evaluate"]["functional"], ctx.checker.symmetry
@@ -162,7 +163,7 @@ def main() -> None:
         out, walls = instantiate.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
         metrics = scene_metrics.consistency(plan, out.room, walls.ids, ctx.checker, out.dropped, out.accepted)
         rows.append((out.ok, out.seconds, metrics["consistency"], out.rejections, len(out.relaxed),
-                     out.attempts, metrics["plan_loss"], len(out.room.object_ids), out.reason))
+                     out.attempts, metrics["plan_loss"], len(out.room.object_ids), f"{plan.scene_id}: {out.reason}"))
         if out.status in tables.SCORED:
             rooms.append(out.room)
             functional.append(functional_checks.score_room(out.room, learned, fn_cfg, sym))

@@ -16,6 +16,7 @@ import pytest
 from pipeline.geometry.frames import to_local, to_world, turn_error, wrap
 from pipeline.geometry.function import REGIONS, back_to_wall, facing_angles, facing_each_other, regions
 from pipeline.geometry.raycast import intersector_class
+from pipeline.placement import order
 from pipeline.placement.checks import Checker
 from pipeline.placement.facing import AnchorFacing, learn_anchor_facing, learn_facing_partners, learn_partner_distances
 from pipeline.placement.layout import add_object, box_frame, wall_frame, walls_of, with_objects
@@ -725,6 +726,40 @@ def test_objects_face_the_objects_and_partner_walls_the_training_rooms_objects_f
                                                       cfg["instantiate"], seed), "c")
     assert sum(down(ahead(turned, seed)) for seed in SEEDS) < len(SEEDS) - 2
     assert all(down(ahead(FacingPartner(turned, {("desk", "chair"): 1.0}, math.pi / 4, 16), seed)) for seed in SEEDS)
+
+
+def test_an_object_goes_before_the_facing_partner_the_plan_puts_against_a_wall_and_so_stands_on_its_line():
+    # the living rooms' miss, with a bed for the sofa: the plan puts the stand adjacent to the left wall and the bed
+    # proximal to the top wall, no edge between them. PlanIT's order places the stand first (adjacent weighs more),
+    # anywhere along its wall; the bed, held near the top wall, then faces it from off its line. Placed first, the bed
+    # faces the stand's wall and the stand slides along it onto the bed's line
+    room, walls, pool, checker, cfg = setup_room(furnished(0), width=5.8, depth=5.1)
+    plan = ScenePlan("s", "r0", "living", ["b", "t"], ["bed", "tv_stand"], ["left-right"] * 2, [1, 1], [None, None],
+                     ["none", "none"], [PlanEdge(walls.ids[2], "b", "spatial", "front", "proximal"),
+                                        PlanEdge(walls.ids[3], "t", "spatial", "front", "adjacent")])
+    partners = {("tv_stand", "bed"): 1.0, ("bed", "tv_stand"): 1.0}
+    assert order.facing_first(plan, partners, set(walls.ids)) == [(0, 1)]
+    assert order.placement_order(plan, {}) == [1, 0]
+    assert order.placement_order(plan, {}, first=order.facing_first(plan, partners, set(walls.ids))) == [0, 1]
+    drawn = BackToWall(Combined(RelationPrior(cfg["extract"]), FaceAway()), {"tv_stand": 1.0})
+    lines = {(a, b, "facing"): CentreLine(1.0, 0.0) for a, b in partners}
+    proposer = Centred(FacingPartner(drawn, partners, math.pi / 4, 8), lines)
+
+    def on_line(seq, seed) -> bool:
+        out = instantiate(plan, room, seq, proposer, Kit(pool, checker), cfg["instantiate"], seed)
+        bed, stand = placed(out, "b"), placed(out, "t")
+        faced = facing_each_other(np.vstack([bed, stand]), math.pi / 4)[0, 1]
+        return bool(faced and abs(to_local(box_frame(bed), stand[:2])[0]) < 0.05)
+
+    assert sum(on_line([1, 0], seed) for seed in SEEDS) < len(SEEDS) - 2
+    assert all(on_line([0, 1], seed) for seed in SEEDS)
+    # not when the object is itself adjacent to a wall (either may then be the one turned), nor against a planned path
+    # from the partner to it
+    both = replace(plan, edges=[PlanEdge(walls.ids[2], "b", "spatial", "front", "adjacent"), plan.edges[1]])
+    assert order.facing_first(both, partners, set(walls.ids)) == []
+    led = replace(plan, edges=[*plan.edges, PlanEdge("t", "b", "spatial", "front", "distant")])
+    assert order.facing_first(led, partners, set(walls.ids)) == []
+    assert order.facing_first(plan, {}, set(walls.ids)) == []
 
 
 class FarEnd:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -30,6 +30,7 @@ class Context:
     pool: ModelPool
     checker: Checker
     mean_area: dict
+    partners: dict = field(default_factory=dict)  # facing partners the search orders by (facing_first); {}: PlanIT's order
 
 
 def load_context(config: dict, corpus: Corpus, wall_bound_share: float = 0.0) -> Context:

@@ -1,9 +1,13 @@
 """The order objects are placed in (PlanIT section 6): topological, depth-first, the most constrained first (C_in,
 weights adjacent 3 : proximal 2 : distant 1), then the most constraining (C_out: C_in times the expected
 footprint area^0.8 over the inclusive descendants); a hub's spokes right after it; a chain as one unit; supported
-(second-tier) objects after every floor object."""
+(second-tier) objects after every floor object; an object before the facing partner the plan puts against a wall
+(:func:`facing_first`, a departure)."""
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+import networkx as nx
 import numpy as np
 
 from .plan import ScenePlan
@@ -61,10 +65,32 @@ def chains(plan: ScenePlan) -> list[list[int]]:
     return out
 
 
+def facing_first(plan: ScenePlan, partners: dict[tuple[str, str], float], walls: set[str]) -> list[tuple[int, int]]:
+    """``(first, then)`` pairs of the plan's floor objects: an object whose category faces the other's in the
+    training rooms (``partners``: (partner category, object category) -> share, :func:`~pipeline.placement.facing.
+    learn_facing_partners`) goes before that partner when the plan puts the partner adjacent to one of ``walls`` (ids)
+    and the object adjacent to none, with no planned edge to an object of the partner's category (an office chair
+    planned at its own desk faces that one) and no planned path from the partner to it.
+    Placed first, the object is drawn facing the partner's wall (``FacingPartner``'s stand-in) and the partner, back to
+    its wall, slides along it onto the object's line (``Centred``); placed second, a wall edge holding it beside another
+    wall (a sofa's end 0.2 m from a side wall) keeps it off the partner's line."""
+    pos = {v: k for k, v in enumerate(plan.ids)}
+    graph = nx.DiGraph([(pos[e.source], pos[e.target]) for e in plan.edges if e.source in pos and e.target in pos])
+    graph.add_nodes_from(range(len(plan.ids)))
+    at_wall = {pos[e.target] for e in plan.edges if e.source in walls and e.target in pos
+               and e.edge_type == "spatial" and e.distance == "adjacent"}
+    floor = [k for k, parent in enumerate(plan.parent) if parent is None]
+    joined = lambda k, cat: any(plan.categories[u] == cat for u in nx.all_neighbors(graph, k))
+    return [(k, j) for k in floor if k not in at_wall for j in floor if j in at_wall
+            and (plan.categories[j], plan.categories[k]) in partners
+            and not joined(k, plan.categories[j]) and not nx.has_path(graph, j, k)]
+
+
 def placement_order(plan: ScenePlan, mean_area: dict[str, float], constrained: bool = True,
-                    rng: np.random.Generator | None = None) -> list[int]:
+                    rng: np.random.Generator | None = None, first: Sequence[tuple[int, int]] = ()) -> list[int]:
     """Object indices in placement order. ``constrained=False`` (the ablation): a seeded random order that keeps
-    only floor objects before supported ones."""
+    only floor objects before supported ones. ``first``: ``(first, then)`` pairs placed in that order as if ``then``
+    were planned with an edge from ``first`` (:func:`facing_first`)."""
     n = len(plan.ids)
     tier2 = np.array([t >= 2 for t in plan.tier], bool)
     if not constrained:
@@ -80,6 +106,8 @@ def placement_order(plan: ScenePlan, mean_area: dict[str, float], constrained: b
             anchors[t].add(s)
             if "hub" in plan.role[s] and plan.role[t] == "spoke":
                 spokes[s].append(t)
+    for k, j in first:
+        anchors[j].add(k)
     unit_of = {k: u for u in chains(plan) for k in u}
     order: list[int] = []
     placed_at: dict[int, int] = {}

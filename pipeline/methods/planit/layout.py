@@ -79,6 +79,14 @@ def make_proposer(location: str, saved, cfg: dict, extract: dict, rules: PoseRul
     return base
 
 
+def ordered_by_partners(ctx: Context, rules: PoseRules, cfg: dict) -> Context:
+    """``ctx`` with the facing partners the search orders by (:func:`~pipeline.placement.order.facing_first`): the
+    training rooms' (``rules.partners``) where the variant snaps and ``snap.partner_first`` (``cfg``: its instantiate
+    settings), else none (PlanIT's order)."""
+    on = cfg["snap"]["enabled"] and cfg["snap"]["partner_first"]
+    return replace(ctx, partners=dict(rules.partners) if on else {})
+
+
 def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
     """The training rooms' pose rules (``instantiate.snap``'s settings): centre lines and back edges of objects on
     supports, beside floor anchors and facing each other; backs to walls; facing partners and anchors; turns on
@@ -137,7 +145,8 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
         raise InputError(f"scene {plan.scene_id}: its room {plan.room_id} is not among the kept rooms of "
                          f"{ctx.corpus.room_type}")
     rng = np.random.default_rng(seed)
-    seq = order.placement_order(plan, ctx.mean_area, variant["ordering"] == "constraint", rng)
+    first = order.facing_first(plan, ctx.partners, set(walls_of(source).ids))
+    seq = order.placement_order(plan, ctx.mean_area, variant["ordering"] == "constraint", rng, first)
     fixed = [plan.ids[k] for k in seq[:keep]]
     start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
     walls = walls_of(start)
@@ -185,8 +194,9 @@ class PlanitLayout:
         if not plans:
             log.warning("%s: no graph of room type '%s' to place: writing empty tables", task.graphs[0],
                         task.corpus.room_type)
-        proposer = make_proposer(self.variant["location"], saved, self.settings, self.config["extract"],
-                                 pose_rules(self.config, task.corpus))
+        rules = pose_rules(self.config, task.corpus)
+        proposer = make_proposer(self.variant["location"], saved, self.settings, self.config["extract"], rules)
+        ctx = ordered_by_partners(ctx, rules, self.settings)
         scored, bar = 0, iter(progress(range(count), desc=f"instantiate {task.corpus.room_type} ({self.name})"))
         for plan in plans:
             if scored >= count:
@@ -219,8 +229,9 @@ class CompleteRoom:
             raise InputError(f"keep: {self.keep}, but room {self.room} has {len(plan.ids)} objects")
         saved = checkpoint.load(task.model, KIND)
         ctx = load_context(self.config, task.corpus, self.config["instantiate"]["wall_bound_share"])
-        proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"],
-                                 pose_rules(self.config, task.corpus))
+        rules = pose_rules(self.config, task.corpus)
+        proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"], rules)
+        ctx = ordered_by_partners(ctx, rules, self.config["instantiate"])
         seed = seed_of(self.config["seed"], "complete", plan.scene_id)
         outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)
         yield scene_of(plan, ctx, outcome, walls)
