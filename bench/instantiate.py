@@ -30,7 +30,7 @@ import torch
 from pipeline import config as config_mod, tables
 from pipeline.evaluation import functional as functional_checks, physical
 from pipeline.evaluation.distributions import category_kl
-from pipeline.evaluation.evaluate import off_axis_gap, off_axis_shares
+from pipeline.evaluation.evaluate import failed_checks, off_axis_gap, off_axis_shares
 from pipeline.geometry.collision import CollisionTest
 from pipeline.geometry.frames import turn_error
 from pipeline.learning import checkpoint
@@ -167,7 +167,7 @@ def main() -> None:
         if out.status in tables.SCORED:
             rooms.append(out.room)
             functional.append(functional_checks.score_room(out.room, learned, fn_cfg, sym))
-            failing[plan.scene_id] = sorted(k for k, v in functional[-1].items() if k.startswith("fn:") and v < 1)
+            failing[plan.scene_id] = failed_checks(functional[-1])
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())
     placed = [r for r in rows if r[0]]
     axis = off_axis_shares(rooms, sym, cfg["evaluate"]["off_axis_angle"])
