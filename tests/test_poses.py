@@ -738,9 +738,9 @@ def test_an_object_goes_before_the_facing_partner_the_plan_puts_against_a_wall_a
                      ["none", "none"], [PlanEdge(walls.ids[2], "b", "spatial", "front", "proximal"),
                                         PlanEdge(walls.ids[3], "t", "spatial", "front", "adjacent")])
     partners = {("tv_stand", "bed"): 1.0, ("bed", "tv_stand"): 1.0}
-    assert order.facing_first(plan, partners, set(walls.ids)) == [(0, 1)]
+    assert order.facing_first(plan, partners, walls) == [(0, 1)]
     assert order.placement_order(plan, {}) == [1, 0]
-    assert order.placement_order(plan, {}, first=order.facing_first(plan, partners, set(walls.ids))) == [0, 1]
+    assert order.placement_order(plan, {}, first=order.facing_first(plan, partners, walls)) == [0, 1]
     drawn = BackToWall(Combined(RelationPrior(cfg["extract"]), FaceAway()), {"tv_stand": 1.0})
     lines = {(a, b, "facing"): CentreLine(1.0, 0.0) for a, b in partners}
     proposer = Centred(FacingPartner(drawn, partners, math.pi / 4, 8), lines)
@@ -756,10 +756,18 @@ def test_an_object_goes_before_the_facing_partner_the_plan_puts_against_a_wall_a
     # not when the object is itself adjacent to a wall (either may then be the one turned), nor against a planned path
     # from the partner to it
     both = replace(plan, edges=[PlanEdge(walls.ids[2], "b", "spatial", "front", "adjacent"), plan.edges[1]])
-    assert order.facing_first(both, partners, set(walls.ids)) == []
+    assert order.facing_first(both, partners, walls) == []
     led = replace(plan, edges=[*plan.edges, PlanEdge("t", "b", "spatial", "front", "distant")])
-    assert order.facing_first(led, partners, set(walls.ids)) == []
-    assert order.facing_first(plan, {}, set(walls.ids)) == []
+    assert order.facing_first(led, partners, walls) == []
+    assert order.facing_first(plan, {}, walls) == []
+    # nor when the plan puts the partner in a corner (adjacent to two walls that meet): the corner holds its place
+    # along each wall, so it goes first; two walls that do not meet change nothing
+    meet = next(w for w in walls.ids[:3] if abs(walls.normal[walls.ids.index(w)] @ walls.normal[3]) < 0.5)
+    cornered = replace(plan, edges=[*plan.edges, PlanEdge(meet, "t", "spatial", "front", "adjacent")])
+    assert order.facing_first(cornered, partners, walls) == []
+    facing = next(w for w in walls.ids[:3] if walls.normal[walls.ids.index(w)] @ walls.normal[3] < -0.99)
+    assert order.facing_first(replace(plan, edges=[*plan.edges, PlanEdge(facing, "t", "spatial", "front", "adjacent")]),
+                              partners, walls) == [(0, 1)]
 
 
 class FarEnd:

@@ -6,11 +6,14 @@ footprint area^0.8 over the inclusive descendants); a hub's spokes right after i
 from __future__ import annotations
 
 from collections.abc import Sequence
+from itertools import combinations
 
 import networkx as nx
 import numpy as np
 
+from ..room import Walls
 from .plan import ScenePlan
+from .walls import PARALLEL_COS
 
 AREA_POWER = 0.8
 
@@ -65,23 +68,30 @@ def chains(plan: ScenePlan) -> list[list[int]]:
     return out
 
 
-def facing_first(plan: ScenePlan, partners: dict[tuple[str, str], float], walls: set[str]) -> list[tuple[int, int]]:
+def facing_first(plan: ScenePlan, partners: dict[tuple[str, str], float], walls: Walls) -> list[tuple[int, int]]:
     """``(first, then)`` pairs of the plan's floor objects: an object whose category faces the other's in the
     training rooms (``partners``: (partner category, object category) -> share, :func:`~pipeline.placement.facing.
-    learn_facing_partners`) goes before that partner when the plan puts the partner adjacent to one of ``walls`` (ids)
-    and the object adjacent to none, with no planned edge to an object of the partner's category (an office chair
+    learn_facing_partners`) goes before that partner when the plan puts the partner adjacent to one of ``walls`` and
+    the object adjacent to none, with no planned edge to an object of the partner's category (an office chair
     planned at its own desk faces that one) and no planned path from the partner to it.
     Placed first, the object is drawn facing the partner's wall (``FacingPartner``'s stand-in) and the partner, back to
     its wall, slides along it onto the object's line (``Centred``); placed second, a wall edge holding it beside another
-    wall (a sofa's end 0.2 m from a side wall) keeps it off the partner's line."""
+    wall (a sofa's end 0.2 m from a side wall) keeps it off the partner's line. Not when the plan puts the partner
+    adjacent to two walls that meet (a corner): the corner holds its place along each wall, so it goes first and the
+    object faces it where it stands."""
     pos = {v: k for k, v in enumerate(plan.ids)}
     graph = nx.DiGraph([(pos[e.source], pos[e.target]) for e in plan.edges if e.source in pos and e.target in pos])
     graph.add_nodes_from(range(len(plan.ids)))
-    at_wall = {pos[e.target] for e in plan.edges if e.source in walls and e.target in pos
-               and e.edge_type == "spatial" and e.distance == "adjacent"}
+    normal = dict(zip(walls.ids, walls.normal))
+    at_wall: dict[int, list[str]] = {}
+    for e in plan.edges:
+        if e.source in normal and e.target in pos and e.edge_type == "spatial" and e.distance == "adjacent":
+            at_wall.setdefault(pos[e.target], []).append(e.source)
+    cornered = {k for k, ids in at_wall.items() if any(abs(normal[a] @ normal[b]) < PARALLEL_COS for a, b in
+                                                      combinations(ids, 2))}
     floor = [k for k, parent in enumerate(plan.parent) if parent is None]
     joined = lambda k, cat: any(plan.categories[u] == cat for u in nx.all_neighbors(graph, k))
-    return [(k, j) for k in floor if k not in at_wall for j in floor if j in at_wall
+    return [(k, j) for k in floor if k not in at_wall for j in floor if j in at_wall and j not in cornered
             and (plan.categories[j], plan.categories[k]) in partners
             and not joined(k, plan.categories[j]) and not nx.has_path(graph, j, k)]
 

@@ -145,7 +145,7 @@ def place_scene(plan: ScenePlan, ctx: Context, proposer, cfg: dict, variant: dic
         raise InputError(f"scene {plan.scene_id}: its room {plan.room_id} is not among the kept rooms of "
                          f"{ctx.corpus.room_type}")
     rng, walls = np.random.default_rng(seed), walls_of(source)  # the architecture's; the kept objects add none
-    first = order.facing_first(plan, ctx.partners, set(walls.ids))
+    first = order.facing_first(plan, ctx.partners, walls)
     seq = order.placement_order(plan, ctx.mean_area, variant["ordering"] == "constraint", rng, first)
     fixed = [plan.ids[k] for k in seq[:keep]]
     start = with_objects(source, [source.object_ids.index(o) for o in fixed if o in source.object_ids])
