@@ -223,7 +223,8 @@ SCHEMAS["scenes"] = pa.schema([
     _f("failures", _STR, doc="JSON: rejections per check (outside, overhangs, collides, violates)"),
     _f("drops", _STR, doc="JSON: per object a partial scene left out, its id, category, cause ('no_place': budget "
        "spent, 'no_model': no training instance, 'no_span': a wall-bound object planned against two facing walls "
-       "no instance spans, 'support_dropped') and, for no_place, the check that refused it most "
+       "no instance spans, 'support_dropped', 'overlap': GRAINS's repair could not clear it) and, for no_place, "
+       "the check that refused it most "
        "('no_cell': no free cell left)"),
     _f("planned_edges", _I32, doc="planned support and spatial edges between placed nodes"),
     _f("found_edges", _I32, doc="of those, found again exactly by extraction"),

@@ -345,15 +345,21 @@ def test_grains_trains_per_room_type_and_its_rooms_are_scored_with_the_cooccurre
 
 
 def test_grains_decoded_furnishes_the_same_trees_in_the_rooms_they_decode(run_dir):
-    """GRAINS's faithful mode: the same decoded trees as grains (the same categories scene by scene), each in its own
-    room: a rectangle centred on the origin with four walls and no doors or windows, written as the scene's own
-    architecture (no source room), which the evaluation reads like any other."""
+    """GRAINS's faithful mode: the same decoded trees as grains (the same categories scene by scene, with what grains's
+    repair left out, recorded in its scenes' drops), each in its own room: a rectangle centred on the origin with four
+    walls and no doors or windows, written as the scene's own architecture (no source room), which the evaluation
+    reads like any other."""
     res = run_dir / "results"
     for room_type in LEARNED:
         gen = res / "generated" / room_type
         cats = {m: {r.removeprefix(f"{m}_"): c for r, c in pd.read_parquet(gen / m / "objects.parquet")
-                    .groupby("room_id")["category"].apply(sorted).items()} for m in ("grains", "grains_decoded")}
-        assert cats["grains"] == cats["grains_decoded"] and cats["grains"]
+                    .groupby("room_id")["category"].apply(list).items()} for m in ("grains", "grains_decoded")}
+        repaired = pd.read_parquet(gen / "grains" / "scenes.parquet")
+        left_out = {r.scene_id.removeprefix("grains_"): [d["category"] for d in json.loads(r.drops)]
+                    for r in repaired.itertuples() if r.drops}
+        assert all(d["cause"] in ("overlap", "support_dropped") for r in repaired.drops.dropna() for d in json.loads(r))
+        assert {r: sorted(c + left_out.get(r, [])) for r, c in cats["grains"].items()} == {
+            r: sorted(c) for r, c in cats["grains_decoded"].items()} and cats["grains"]
         rooms = pd.read_parquet(gen / "grains_decoded" / "rooms.parquet")
         arch = pd.read_parquet(gen / "grains_decoded" / "architecture.parquet")
         scenes = pd.read_parquet(gen / "grains_decoded" / "scenes.parquet")

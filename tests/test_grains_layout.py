@@ -3,15 +3,18 @@ room it was built from (categories, boxes, support parents), and laid onto a lar
 wall."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
+from hypothesis import given, settings, strategies as st
 
 from pipeline.methods.grains.hierarchy import build_tree, decoded_room
 from pipeline.methods.grains.layout import furnish, supports
 from pipeline.placement.retrieval import ModelPool
 from pipeline.room import BOX_COLUMNS
 
-from test_grains_hierarchy import bedroom, make_room
+from test_grains_hierarchy import bedroom, box, make_room
 
 
 def pool_of(room) -> ModelPool:
@@ -23,7 +26,8 @@ def pool_of(room) -> ModelPool:
 def test_a_tree_furnished_into_its_own_room_gives_the_room_back():
     room, parents = bedroom()
     tree = build_tree(room, parents)
-    got, got_parents = furnish(tree, room, pool_of(room), "s")
+    got, got_parents, drops = furnish(tree, room, pool_of(room), "s")
+    assert drops == []
     assert sorted(got.categories) == sorted(room.categories)
     for cat in set(room.categories):
         mine = sorted(map(tuple, np.round(room.boxes[[c == cat for c in room.categories]][:, :3], 6)))
@@ -38,7 +42,7 @@ def test_a_tree_furnished_into_its_own_room_gives_the_room_back():
 def test_a_larger_room_keeps_each_wall_group_on_its_wall():
     room, parents = bedroom()
     big = make_room(np.array([[0, 0], [6, 0], [6, 5], [0, 5]], float), [])
-    got, _ = furnish(build_tree(room, parents), big, pool_of(room), "s")
+    got, _, _ = furnish(build_tree(room, parents), big, pool_of(room), "s")
     desk = got.boxes[got.categories.index("desk")]
     bed = got.boxes[got.categories.index("bed")]
     assert abs(desk[1] + desk[4] - 5.0) < 1e-6 and abs(bed[1] - bed[4]) < 1e-6  # backs on the top and bottom walls
@@ -54,7 +58,7 @@ def test_a_tree_furnishes_the_room_it_decodes_the_source_room_moved_to_the_origi
     assert own.wall_ids == [f"wall_{k}" for k in range(4)] and np.allclose(own.wall_thickness, 0.1)
     assert own.openings == [] and own.object_ids == []
     assert np.allclose(own.wall_segments[:, 1], np.roll(own.outline, -1, 0))
-    got, _ = furnish(tree, own, pool_of(room), "s")
+    got, _, _ = furnish(tree, own, pool_of(room), "s")
     for cat in set(room.categories):
         mine = sorted(map(tuple, np.round(room.boxes[[c == cat for c in room.categories]][:, :3] - [2, 1.5, 0], 6)))
         theirs = sorted(map(tuple, np.round(got.boxes[[c == cat for c in got.categories]][:, :3], 6)))
@@ -79,5 +83,81 @@ def test_within_retrieval_never_takes_a_model_wider_than_the_decoded_box():
 
 def test_within_retrieval_furnishes_the_source_room_back():
     room, parents = bedroom()
-    got, _ = furnish(build_tree(room, parents), room, pool_of(room), "s", retrieval="within")
+    got, _, _ = furnish(build_tree(room, parents), room, pool_of(room), "s", retrieval="within")
     assert sorted(got.model_ids) == sorted(room.model_ids)
+
+
+RESOLVE = {"enabled": True, "margin": 0.01, "max_moves": 8}  # margin: the placement checks' collision depth
+
+
+def _floor_penetration(room) -> float:
+    from pipeline.geometry.boxes import penetration_depths
+    floor = room.boxes[room.boxes[:, 2] - room.boxes[:, 5] < 0.01]
+    return float(np.triu(penetration_depths(floor), 1).max())
+
+
+def test_the_repair_moves_only_what_overlaps_by_the_shortest_move():
+    """The hand-built bedroom's chair reaches 5 cm into the bed's corner (everything else stands flush, within the
+    collision depth): repaired, the chair alone moves, 5 cm along the desk's front, away from the bed."""
+    room, parents = bedroom()
+    got, _, drops = furnish(build_tree(room, parents), room, pool_of(room), "s", resolve=RESOLVE)
+    assert drops == []
+    for k, i in enumerate(room.object_ids):
+        moved = got.boxes[got.categories.index(room.categories[k])] if room.categories.count(room.categories[k]) == 1 \
+            else None
+        if moved is not None:
+            assert np.allclose(moved[:6], room.boxes[k, :6] - ([0.05, 0, 0, 0, 0, 0] if i == "chair" else 0), atol=1e-6), i
+
+
+def test_two_walls_groups_meeting_in_a_corner_are_moved_apart_the_larger_kept_where_it_stood():
+    """GRAINS codes no place between two walls' groups: a wardrobe of the right wall's group and a dresser of the
+    bottom wall's overlap 0.3 m in the corner (as decoded trees do). Laid out raw, they penetrate; repaired, the
+    dresser (the smaller) moves off the wardrobe by the shortest move that clears it (0.3 m along the bottom wall),
+    the lamp on it moves with it, and the wardrobe stands where it stood."""
+    outline = np.array([[0, 0], [4, 0], [4, 3], [0, 3]], float)
+    objects = [("wardrobe", "wardrobe", box(3.7, 1.0, 0.3, 0.9, 1.0)),
+               ("dresser", "dresser", box(3.2, 0.3, 0.5, 0.3, 0.4)),
+               ("lamp", "table_lamp", box(3.2, 0.3, 0.1, 0.1, 0.2, 0.0, 0.8))]
+    room = make_room(outline, objects)
+    parents = {"wardrobe": None, "dresser": None, "lamp": "dresser"}
+    tree = build_tree(room, parents)
+    raw, _, _ = furnish(tree, room, pool_of(room), "s")
+    assert _floor_penetration(raw) > 0.29
+    got, got_parents, drops = furnish(tree, room, pool_of(room), "s", resolve=RESOLVE)
+    assert drops == [] and _floor_penetration(got) <= 1e-9
+    at = {c: got.boxes[got.categories.index(c)] for c in got.categories}
+    assert np.allclose(at["wardrobe"][:2], [3.7, 1.0], atol=1e-6)
+    assert np.allclose(at["dresser"][:2], [3.2 - 0.3, 0.3], atol=1e-6)
+    assert np.allclose(at["table_lamp"][:2], at["dresser"][:2], atol=1e-6)
+
+
+def test_an_object_no_move_clears_inside_the_room_is_left_out_with_what_stands_on_it():
+    """A 1.2 x 1 m room holding a 1 x 0.6 m cabinet and a 1 x 0.5 m dresser overlapping it: no move clears them inside
+    its rectangle, so the smaller is left out (cause overlap) and the lamp on it with it (support_dropped)."""
+    outline = np.array([[0, 0], [1.2, 0], [1.2, 1.0], [0, 1.0]], float)
+    objects = [("a", "cabinet", box(0.6, 0.3, 0.5, 0.3, 0.4)), ("b", "dresser", box(0.6, 0.5, 0.5, 0.25, 0.4)),
+               ("lamp", "table_lamp", box(0.6, 0.5, 0.1, 0.1, 0.2, 0.0, 0.8))]
+    room = make_room(outline, objects)
+    got, _, drops = furnish(build_tree(room, {"a": None, "b": None, "lamp": "b"}), room, pool_of(room), "s",
+                            resolve=RESOLVE)
+    assert sorted(got.categories) == ["cabinet"]
+    assert sorted((d["category"], d["cause"]) for d in drops) == [("dresser", "overlap"), ("table_lamp", "support_dropped")]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.floats(-1.0, 1.0), min_size=2, max_size=2), st.lists(st.floats(0.1, 1.0), min_size=4, max_size=4),
+       st.floats(-math.pi, math.pi), st.floats(-math.pi, math.pi))
+def test_every_clearing_move_clears_the_footprints_and_the_first_is_the_penetration_depth(at, halves, yaw_a, yaw_b):
+    from pipeline.geometry.boxes import clearing_moves, penetration_depths
+    a = np.array([0.0, 0.0, 5.0, halves[0], halves[1], 5.0, yaw_a])  # taller than any plan depth
+    b = np.array([at[0], at[1], 5.0, halves[2], halves[3], 5.0, yaw_b])
+    moves = clearing_moves(a, b, 0.01)
+    assert moves.shape == (8, 2) and np.all(np.diff(np.linalg.norm(moves, axis=1)) >= -1e-12)
+    for move in moves:
+        moved = b.copy()
+        moved[:2] += move
+        assert penetration_depths(np.stack([a, moved]))[0, 1] == 0.0
+    depth = penetration_depths(np.stack([a, b]))[0, 1]  # the boxes share their height: the plan's depth
+    assert depth == 0.0 or np.linalg.norm(moves[0]) >= depth + 0.01 - 1e-9
+    if depth > 0 and yaw_a == yaw_b == 0.0 and abs(at[0]) >= abs(halves[0] - halves[2]):  # no projection inside another
+        assert np.linalg.norm(moves[0]) <= depth + 0.01 + 1e-9 or abs(at[1]) < abs(halves[1] - halves[3])

@@ -64,6 +64,22 @@ def footprint_overlap(corners_a: np.ndarray, yaw_a: np.ndarray, corners_b: np.nd
     return cast(np.ndarray, overlap.min(axis=1))
 
 
+def clearing_moves(anchor: np.ndarray, target: np.ndarray, margin: float = 0.0) -> np.ndarray:
+    """``(8, 2)`` floor translations of ``target (7,)`` that clear ``anchor (7,)``'s footprint by ``margin`` m, one
+    per separating axis of the two footprints (both boxes' local axes) and side, shortest first: moved by any of
+    them, the footprints' projections on that axis lie ``margin`` apart. The first is the minimum translation of the
+    overlapping footprints (at least the plan part of :func:`penetration_depths`, which is the projections' shared
+    length: more where one projection holds the other)."""
+    a, b = np.asarray(anchor, float).reshape(7), np.asarray(target, float).reshape(7)
+    corners = footprint_corners([a[0], b[0]], [a[1], b[1]], [a[3], b[3]], [a[4], b[4]], [a[6], b[6]])
+    axes = np.concatenate([_axes(np.array([a[6]]))[0], _axes(np.array([b[6]]))[0]])  # (4, 2)
+    pa, pb = corners[0] @ axes.T, corners[1] @ axes.T  # (4 corners, 4 axes)
+    up = pa.max(0) - pb.min(0) + margin  # along +axis: target's low side past anchor's high side
+    down = pb.max(0) - pa.min(0) + margin  # along -axis
+    moves = np.concatenate([axes * up[:, None], -axes * down[:, None]])
+    return moves[np.argsort(np.linalg.norm(moves, axis=1), kind="stable")]
+
+
 def penetration_depths(boxes: np.ndarray) -> np.ndarray:
     """``(n, n)`` interpenetration depth of every box pair (0 where they do not overlap).
 

@@ -88,15 +88,15 @@ BUILTIN = [
            "cluster by the edge tagger, assembled breadth-first from the walls with repair"),
     Method("grains", "pipeline.methods.grains.layout:GrainsLayout", model="grains",
            keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "grains.snap", "grains.retrieval",
-                                      *CONTEXT_KEYS],
+                                      "grains.resolve", *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
            description="GRAINS: hierarchies decoded from a recursive VAE's prior, each wall group laid onto a held-out "
-           "room's wall, models retrieved by size"),
+           "room's wall, models retrieved by size, colliding floor objects moved apart (grains.resolve)"),
     Method("grains_decoded", "pipeline.methods.grains.layout:GrainsDecoded", model="grains",
            keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "grains.snap", *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
            description="GRAINS's faithful mode: the same hierarchies, each furnishing the rectangle its own root and "
-           "walls decode (no doors or windows), models retrieved by size"),
+           "walls decode (no doors or windows), models retrieved by size, nothing repaired"),
     Method("infinigen", "pipeline.methods.infinigen.layout:InfinigenLayout", program="infinigen",
            keys=_solver_keys("infinigen"), scenes=lambda config, name: config["infinigen"]["scenes"],
            description="an Infinigen-Indoors-style constraint program per room type, derived from the training split, "
