@@ -149,9 +149,7 @@ def main() -> None:
     draws = cfg["instantiate"]["graph_draws"] if args.graphs == "sampled" else 1
     plans = instantiate.select_plans(cfg, variant, ctx.corpus, graphs / "nodes.parquet", graphs / "edges.parquet",
                                      args.scenes * draws)
-    rules = instantiate.pose_rules(cfg, ctx.corpus)
-    proposer = instantiate.make_proposer(args.location, saved, cfg["instantiate"], cfg["extract"], rules)
-    ctx = instantiate.ordered_by_partners(ctx, rules, cfg["instantiate"])
+    ctx, proposer = instantiate.search_kit(cfg, ctx, args.location, saved, cfg["instantiate"])
     rows, rooms, failing, colliding, ev = [], [], {}, 0, CollisionTest.of(cfg["evaluate"]["collision"]["penetration"],
                                                      cfg["evaluate"]["collision"]["max_penetration"], ctx.checker.intersector)
     fn_cfg, sym = cfg["evaluate"]["functional"], ctx.checker.symmetry

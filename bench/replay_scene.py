@@ -67,9 +67,7 @@ def main() -> None:
     plan = next(p for p in plans if p.scene_id.endswith(args.scene))
     for cls in WRAPPERS:
         logged(cls, set(args.watch.split(",")))
-    rules = inst.pose_rules(cfg, ctx.corpus)
-    proposer = inst.make_proposer(location, saved, cfg["instantiate"], cfg["extract"], rules)
-    ctx = inst.ordered_by_partners(ctx, rules, cfg["instantiate"])
+    ctx, proposer = inst.search_kit(cfg, ctx, location, saved, cfg["instantiate"])
     seed = bench_seed(cfg, plan.scene_id) if args.bench else seed_of(cfg["seed"], args.method, plan.scene_id)
     out, _ = inst.place_scene(plan, ctx, proposer, cfg["instantiate"], variant, seed)
     boxes = out.room.boxes.reshape(-1, 7)

@@ -87,6 +87,14 @@ def ordered_by_partners(ctx: Context, rules: PoseRules, cfg: dict) -> Context:
     return replace(ctx, partners=dict(rules.partners) if on else {})
 
 
+def search_kit(config: dict, ctx: Context, location: str, saved, settings: dict):
+    """(context, proposer): what the search places with in a location mode (``settings``: its instantiate settings):
+    ``ctx`` ordered by the training rooms' facing partners (:func:`ordered_by_partners`) and the location proposer
+    wrapped by the training rooms' pose rules (:func:`pose_rules`, :func:`make_proposer`)."""
+    rules = pose_rules(config, ctx.corpus)
+    return ordered_by_partners(ctx, rules, settings), make_proposer(location, saved, settings, config["extract"], rules)
+
+
 def pose_rules(config: dict, corpus: Corpus) -> PoseRules:
     """The training rooms' pose rules (``instantiate.snap``'s settings): centre lines and back edges of objects on
     supports, beside floor anchors and facing each other; backs to walls; facing partners and anchors; turns on
@@ -193,9 +201,7 @@ class PlanitLayout:
         if not plans:
             log.warning("%s: no graph of room type '%s' to place: writing empty tables", task.graphs[0],
                         task.corpus.room_type)
-        rules = pose_rules(self.config, task.corpus)
-        proposer = make_proposer(self.variant["location"], saved, self.settings, self.config["extract"], rules)
-        ctx = ordered_by_partners(ctx, rules, self.settings)
+        ctx, proposer = search_kit(self.config, ctx, self.variant["location"], saved, self.settings)
         scored, bar = 0, iter(progress(range(count), desc=f"instantiate {task.corpus.room_type} ({self.name})"))
         for plan in plans:
             if scored >= count:
@@ -228,9 +234,7 @@ class CompleteRoom:
             raise InputError(f"keep: {self.keep}, but room {self.room} has {len(plan.ids)} objects")
         saved = checkpoint.load(task.model, KIND)
         ctx = load_context(self.config, task.corpus, self.config["instantiate"]["wall_bound_share"])
-        rules = pose_rules(self.config, task.corpus)
-        proposer = make_proposer("cfcn", saved, self.config["instantiate"], self.config["extract"], rules)
-        ctx = ordered_by_partners(ctx, rules, self.config["instantiate"])
+        ctx, proposer = search_kit(self.config, ctx, "cfcn", saved, self.config["instantiate"])
         seed = seed_of(self.config["seed"], "complete", plan.scene_id)
         outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)
         yield scene_of(plan, ctx, outcome, walls)
