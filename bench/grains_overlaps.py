@@ -24,7 +24,8 @@ import numpy as np
 import torch
 
 from pipeline import config as config_mod
-from pipeline.geometry.boxes import penetration_depths
+from pipeline.geometry.boxes import from_corners, penetration_depths
+from pipeline.geometry.polygon import outside_pieces
 from pipeline.learning import checkpoint
 from pipeline.methods.grains.hierarchy import Node, anchor, decoded_room, layout, leaves, room_rect
 from pipeline.methods.grains.layout import retrieved_boxes, root_of, supports
@@ -130,7 +131,9 @@ def main() -> None:
                     got = retrieved_boxes(placed, insts, on)
                     tally[key] = [a + c for a, c in zip(tally[key], colliding_share(got, on, limit))]
                 floor = [k for k, inst in enumerate(insts) if inst is not None and k not in on]
-                moves, left_out = separated(got, floor, room_rect(room), limit, cfg["grains"]["resolve"]["max_moves"])
+                beyond = from_corners(outside_pieces(room.outline, room_rect(room)), 0.0, 2 * float(room.height))
+                moves, left_out = separated(got, floor, room_rect(room), limit, cfg["grains"]["resolve"]["max_moves"],
+                                            beyond)
                 got[:, :2] += moves[[root_of(k, on) for k in range(len(got))]]
                 kept = np.array([k for k in range(len(got)) if k not in left_out and root_of(k, on) not in left_out], int)
                 kept_on = {int(np.searchsorted(kept, c)): int(np.searchsorted(kept, p)) for c, p in on.items() if c in kept}

@@ -161,3 +161,23 @@ def test_every_clearing_move_clears_the_footprints_and_the_first_is_the_penetrat
     assert depth == 0.0 or np.linalg.norm(moves[0]) >= depth + 0.01 - 1e-9
     if depth > 0 and yaw_a == yaw_b == 0.0 and abs(at[0]) >= abs(halves[0] - halves[2]):  # no projection inside another
         assert np.linalg.norm(moves[0]) <= depth + 0.01 + 1e-9 or abs(at[1]) < abs(halves[1] - halves[3])
+
+
+def test_objects_through_the_walls_come_back_inside_and_off_an_l_shaped_rooms_missing_corner():
+    """A wardrobe decoded 0.4 m through the right wall of a 4 x 3 m rectangle comes back to touch it; in an L-shaped
+    room (the rectangle's top-left 1.5 x 1 m corner missing), a dresser decoded in that corner moves out of it by the
+    shortest move (down to the inner wall at y = 2), as the evaluation would find it out of bounds there."""
+    outline = np.array([[0, 0], [4, 0], [4, 3], [0, 3]], float)
+    room = make_room(outline, [("wardrobe", "wardrobe", box(3.9, 1.5, 0.3, 0.9, 1.0))])
+    got, _, drops = furnish(build_tree(room, {"wardrobe": None}), room, pool_of(room), "s", resolve=RESOLVE)
+    assert drops == [] and np.allclose(got.boxes[0, :2], [3.7, 1.5], atol=1e-6)
+    ell = np.array([[0, 0], [4, 0], [4, 3], [1.5, 3], [1.5, 2], [0, 2]], float)
+    source = make_room(outline, [("dresser", "dresser", box(0.6, 2.5, 0.5, 0.3, 0.4)),
+                                 ("bed", "bed", box(3.0, 1.0, 0.8, 1.0, 0.3))])
+    tree = build_tree(source, {"dresser": None, "bed": None})
+    into = make_room(ell, [])
+    raw, _, _ = furnish(tree, into, pool_of(source), "s")
+    got, _, drops = furnish(tree, into, pool_of(source), "s", resolve=RESOLVE)
+    at = {c: got.boxes[got.categories.index(c)] for c in got.categories}
+    assert drops == [] and np.allclose(at["bed"][:2], raw.boxes[raw.categories.index("bed")][:2])
+    assert np.allclose(at["dresser"][:2], [0.6, 2.0 - 0.3], atol=1e-6)

@@ -32,6 +32,19 @@ def footprint_corners(cx: ArrayLike, cy: ArrayLike, hx: ArrayLike, hy: ArrayLike
     return cast(np.ndarray, world + np.stack([cx, cy], -1)[:, None, :])
 
 
+def from_corners(corners: np.ndarray, z0: float, z1: float) -> np.ndarray:
+    """``(m, 7)`` boxes standing from ``z0`` to ``z1`` m on the rectangles ``corners (m, 4, 2)`` (consecutive corners),
+    their local x along each rectangle's first edge."""
+    c = np.asarray(corners, float).reshape(-1, 4, 2)
+    x, y = c[:, 1] - c[:, 0], c[:, 3] - c[:, 0]
+    centre = c.mean(1)
+    out = np.empty((len(c), 7))
+    out[:, :2], out[:, 2], out[:, 5] = centre, (z0 + z1) / 2, (z1 - z0) / 2
+    out[:, 3], out[:, 4] = np.linalg.norm(x, axis=1) / 2, np.linalg.norm(y, axis=1) / 2
+    out[:, 6] = np.arctan2(x[:, 1], x[:, 0])
+    return out
+
+
 def on_floor(boxes: np.ndarray, floor_contact: float) -> np.ndarray:
     """``(n,)`` bool: the boxes ``(n, 7)`` whose bottom lies within ``floor_contact`` m of the floor (z = 0)."""
     b = np.asarray(boxes, float).reshape(-1, 7)

@@ -156,6 +156,17 @@ def outside_area(outline: np.ndarray, corners: np.ndarray, erode: float) -> np.n
     return cast(np.ndarray, shapely.area(shapely.difference(eroded, shapely.Polygon(outline))))
 
 
+def outside_pieces(outline: np.ndarray, rect: tuple[float, float, float, float]) -> np.ndarray:
+    """``(m, 4, 2)`` corners of the oriented rectangles enclosing each part of ``rect = (xmin, ymin, xmax, ymax)`` (m)
+    that lies outside the polygon ``outline (k, 2)``: an L-shaped room's missing corner; none for a room that fills
+    its rectangle."""
+    import shapely
+
+    rest = shapely.box(*rect).difference(shapely.Polygon(outline))
+    parts = [g for g in getattr(rest, "geoms", [rest]) if g.area > 1e-9]
+    return np.array([np.asarray(shapely.oriented_envelope(g).exterior.coords)[:4] for g in parts], float).reshape(-1, 4, 2)
+
+
 def door_zones(outline: np.ndarray, doors: np.ndarray, depth: float) -> np.ndarray:
     """``(m, 4, 2)`` counter-clockwise rectangles reaching ``depth`` m into the room from each door segment of
     ``doors (m, 2, 2)`` (the side whose point just off the door's midpoint lies inside ``outline (k, 2)``)."""

@@ -16,6 +16,8 @@ from typing import Iterator
 import numpy as np
 import torch
 
+from ...geometry.boxes import from_corners
+from ...geometry.polygon import outside_pieces
 from ...learning import checkpoint
 from ...log import progress
 from ...placement.layout import add_object, walls_of, with_objects
@@ -73,8 +75,9 @@ def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False, 
     unrecorded (the training split lacks them). ``snap``: the codes' bits win over their reals
     (:func:`.relpos.decode`); ``retrieval``: ``nearest`` (GRAINS's) or ``within`` (the nearest whose footprint fits the
     decoded one, :func:`~pipeline.placement.retrieval.nearest_within`); ``resolve``: ``grains.resolve`` with the
-    collision depth as ``margin`` (enabled: colliding floor objects moved apart, :func:`.resolve.separated`; one still
-    colliding is left out, cause ``overlap``, with what stands on it, cause ``support_dropped``)."""
+    collision depth as ``margin`` (enabled: floor objects moved inside the room's rectangle and off each other and
+    off what of the rectangle lies outside the room, :func:`.resolve.separated`; one still colliding is left out, cause
+    ``overlap``, with what stands on it, cause ``support_dropped``)."""
     rect = room_rect(room)
     placed = layout(tree, rect, snap)
     on = supports(tree)
@@ -83,8 +86,9 @@ def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False, 
     moves, overlapping = np.zeros((len(placed), 2)), []
     if resolve and resolve["enabled"]:
         floor = [k for k, inst in enumerate(insts) if inst is not None and k not in on]
+        beyond = from_corners(outside_pieces(room.outline, rect), 0.0, 2 * float(room.height))
         moves, overlapping = separated(retrieved_boxes(placed, insts, on), floor, rect, resolve["margin"],
-                                       resolve["max_moves"])
+                                       resolve["max_moves"], beyond)
     out, ids, parents, drops = with_objects(room, []), {}, {}, []
     for k, (label, _, box) in enumerate(placed):
         inst = insts[k]

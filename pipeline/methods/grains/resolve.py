@@ -5,10 +5,12 @@ Why (issue 42, docs/benchmarks.md): GRAINS's hierarchy groups the floor objects 
 codes each one's place against its group only; no code relates two walls' groups, and the decoder lays each group
 against its wall alone. On the default run's bedrooms 51 of 64 colliding floor-object pairs belonged to two walls'
 groups (a wardrobe of one wall in the corner a dresser of the next wall also takes), 8 to pairs a code places one
-against the other. The repair moves objects, largest footprint first, out of what is already kept: each colliding
-object takes the shortest of the clearing moves (:func:`~pipeline.geometry.boxes.clearing_moves`) that leaves the
-least penetration with everything kept and takes it no further out of the room's rectangle than it stood; an object
-still colliding after ``max_moves`` moves is left out (recorded by the caller). Objects on a support move with it."""
+against the other; and a fifth of its floor objects reach through the walls. The repair moves objects, largest
+footprint first: each is first moved inside the room's rectangle, then, if it penetrates what is already kept (or
+the part of the rectangle outside an L-shaped room), takes the shortest of the clearing moves
+(:func:`~pipeline.geometry.boxes.clearing_moves`) that leaves the least penetration with everything kept and takes it
+no further out of the rectangle; an object still colliding after ``max_moves`` moves is left out (recorded by the
+caller). Objects on a support move with it."""
 from __future__ import annotations
 
 import numpy as np
@@ -21,6 +23,15 @@ def outside(box: np.ndarray, rect: tuple[float, float, float, float]) -> float:
     c = footprint_corners(box[0], box[1], box[3], box[4], box[6])[0]
     lo, hi = np.array(rect[:2]) - c.min(0), c.max(0) - np.array(rect[2:])
     return float(max(lo.max(), hi.max(), 0.0))
+
+
+def inside_move(box: np.ndarray, rect: tuple[float, float, float, float]) -> np.ndarray:
+    """``(2,)`` the shortest move that brings the footprint of ``box (7,)`` inside ``rect`` on each axis it fits along
+    (centred on an axis it does not fit along)."""
+    c = footprint_corners(box[0], box[1], box[3], box[4], box[6])[0]
+    lo, hi, rlo, rhi = c.min(0), c.max(0), np.array(rect[:2]), np.array(rect[2:])
+    fits = hi - lo <= rhi - rlo
+    return np.where(fits, np.maximum(rlo - lo, 0.0) - np.maximum(hi - rhi, 0.0), (rlo + rhi - lo - hi) / 2)
 
 
 def depths(kept: np.ndarray, box: np.ndarray) -> np.ndarray:
@@ -49,17 +60,21 @@ def best_move(kept: np.ndarray, box: np.ndarray, rect: tuple[float, float, float
 
 
 def separated(boxes: np.ndarray, floor: list[int], rect: tuple[float, float, float, float], margin: float,
-              max_moves: int) -> tuple[np.ndarray, list[int]]:
+              max_moves: int, fixed: np.ndarray | None = None) -> tuple[np.ndarray, list[int]]:
     """``(n, 2)`` the floor move of each of ``boxes (n, 7)``'s ``floor`` objects (0 for the rest) and the floor objects
-    left out, so that no two kept floor boxes penetrate deeper than ``margin`` m (the placement checks' collision
-    depth: a nightstand flush with its bed stays); the largest footprints are kept first, unmoved."""
+    left out, so that each kept floor box lies inside ``rect`` where it fits and no two kept floor boxes, nor a kept
+    one and a ``fixed (m, 7)`` box (what of the rectangle lies outside the room), penetrate deeper than ``margin`` m
+    (the placement checks' collision depth: a nightstand flush with its bed stays); the largest footprints are kept
+    first."""
     moves = np.zeros((len(boxes), 2))
     kept: list[int] = []
     dropped: list[int] = []
+    fixed = np.zeros((0, 7)) if fixed is None else np.asarray(fixed, float).reshape(-1, 7)
     for k in sorted(floor, key=lambda k: -4 * boxes[k, 3] * boxes[k, 4]):
-        placed = boxes[kept].copy()
-        placed[:, :2] += moves[kept]
+        placed = np.vstack([fixed, boxes[kept]])
+        placed[len(fixed):, :2] += moves[kept]
         box = boxes[k].copy()
+        box[:2] += inside_move(box, rect)
         for _ in range(max_moves):
             move = best_move(placed, box, rect, margin) if (depths(placed, box) > margin).any() else None
             if move is None:
