@@ -24,12 +24,11 @@ import numpy as np
 import torch
 
 from pipeline import config as config_mod
-from pipeline.geometry.boxes import from_corners, penetration_depths
-from pipeline.geometry.polygon import outside_pieces
+from pipeline.geometry.boxes import penetration_depths
 from pipeline.learning import checkpoint
 from pipeline.methods.grains.hierarchy import Node, anchor, decoded_room, layout, leaves, room_rect
 from pipeline.methods.grains.layout import retrieved_boxes, root_of, supports
-from pipeline.methods.grains.resolve import separated
+from pipeline.methods.grains.resolve import beyond, separated
 from pipeline.methods.grains.train import KIND, build_model
 from pipeline.methods.placing import load_context
 from pipeline.placement.retrieval import nearest, nearest_within
@@ -113,7 +112,7 @@ def main() -> None:
     tally = {k: [0, 0] for k in ("decoded", "decoded_snapped", "retrieved", "retrieved_within", "resolved")}
     for mode, faithful in (("held-out rooms", False), ("decoded rooms", True)):
         kinds: dict[str, int] = {}
-        dropped = [0]
+        dropped = 0
         for k, tree in enumerate(trees):
             room = decoded_room(tree, f"s{k}", args.room_type) if faithful else rooms[k % len(rooms)]
             on = supports(tree)
@@ -128,22 +127,25 @@ def main() -> None:
                 kinds = {k: kinds.get(k, 0) + v for k, v in pairs.items()}
                 for key, pick in (("retrieved", nearest), ("retrieved_within", nearest_within)):
                     insts = [pick(ctx.pool, label, box[3:6]) for label, _, box in placed]
-                    got = retrieved_boxes(placed, insts, on)
-                    tally[key] = [a + c for a, c in zip(tally[key], colliding_share(got, on, limit))]
+                    tally[key] = [a + c for a, c in zip(tally[key], colliding_share(retrieved_boxes(placed, insts, on),
+                                                                                    on, limit))]
+                # the repair, on the grains method's retrieval
+                pick = nearest_within if cfg["grains"]["retrieval"] == "within" else nearest
+                insts = [pick(ctx.pool, label, box[3:6]) for label, _, box in placed]
+                got, rect = retrieved_boxes(placed, insts, on), room_rect(room)
                 floor = [k for k, inst in enumerate(insts) if inst is not None and k not in on]
-                beyond = from_corners(outside_pieces(room.outline, room_rect(room)), 0.0, 2 * float(room.height))
-                moves, left_out = separated(got, floor, room_rect(room), limit, cfg["grains"]["resolve"]["max_moves"],
-                                            beyond)
+                moves, left_out = separated(got, floor, rect, limit, cfg["grains"]["resolve"]["max_moves"],
+                                            beyond(room, rect))
                 got[:, :2] += moves[[root_of(k, on) for k in range(len(got))]]
                 kept = np.array([k for k in range(len(got)) if k not in left_out and root_of(k, on) not in left_out], int)
                 kept_on = {int(np.searchsorted(kept, c)): int(np.searchsorted(kept, p)) for c, p in on.items() if c in kept}
                 tally["resolved"] = [a + c for a, c in zip(tally["resolved"], colliding_share(got[kept], kept_on, limit))]
-                dropped[0] += len(left_out)
+                dropped += len(left_out)
         report({"room_type": args.room_type, "rooms": mode, "scenes": len(trees), "collision_margin_m": limit,
                 "snap": cfg["grains"]["snap"],
                 **{f"{k}_colliding_share": round(v[0] / max(v[1], 1), 4) for k, v in tally.items()},
                 "floor_objects": tally["decoded"][1], "colliding_pairs_by_relation": kinds,
-                "resolved_left_out": dropped[0]},
+                "resolved_left_out": dropped},
                args.workdir, f"grains_overlaps_{args.room_type}_{'decoded' if faithful else 'heldout'}")
         tally = {k: [0, 0] for k in tally}
 

@@ -156,15 +156,22 @@ def outside_area(outline: np.ndarray, corners: np.ndarray, erode: float) -> np.n
     return cast(np.ndarray, shapely.area(shapely.difference(eroded, shapely.Polygon(outline))))
 
 
+RECT_FILL = 0.99  # a part of a rectangle outside a room counts as a rectangle when it fills this share of its envelope
+
+
 def outside_pieces(outline: np.ndarray, rect: tuple[float, float, float, float]) -> np.ndarray:
-    """``(m, 4, 2)`` corners of the oriented rectangles enclosing each part of ``rect = (xmin, ymin, xmax, ymax)`` (m)
-    that lies outside the polygon ``outline (k, 2)``: an L-shaped room's missing corner; none for a room that fills
-    its rectangle."""
+    """``(m, 4, 2)`` corners of the parts of ``rect = (xmin, ymin, xmax, ymax)`` (m) that lie outside the polygon
+    ``outline (k, 2)`` and are rectangles (each fills :data:`RECT_FILL` of its oriented envelope): an L-shaped room's
+    missing corner; none for a room that fills its rectangle. A part that is no rectangle (the triangle a slanted wall
+    leaves, the notch of a room with a stepped side, a floating-point sliver) is left out: its envelope would reach
+    into the room."""
     import shapely
 
     rest = shapely.box(*rect).difference(shapely.Polygon(outline))
-    parts = [g for g in getattr(rest, "geoms", [rest]) if g.area > 1e-9]
-    return np.array([np.asarray(shapely.oriented_envelope(g).exterior.coords)[:4] for g in parts], float).reshape(-1, 4, 2)
+    parts = [g for g in getattr(rest, "geoms", [rest]) if g.area > 1e-6]
+    envelopes = [shapely.oriented_envelope(g) for g in parts]
+    return np.array([np.asarray(e.exterior.coords)[:4] for g, e in zip(parts, envelopes) if g.area >= RECT_FILL * e.area],
+                    float).reshape(-1, 4, 2)
 
 
 def door_zones(outline: np.ndarray, doors: np.ndarray, depth: float) -> np.ndarray:

@@ -16,8 +16,6 @@ from typing import Iterator
 import numpy as np
 import torch
 
-from ...geometry.boxes import from_corners
-from ...geometry.polygon import outside_pieces
 from ...learning import checkpoint
 from ...log import progress
 from ...placement.layout import add_object, walls_of, with_objects
@@ -27,7 +25,7 @@ from ...seeding import seed_of
 from ..interface import Scene, Task
 from ..placing import load_context
 from .hierarchy import Node, anchor, decoded_room, layout, leaves, room_rect
-from .resolve import separated
+from .resolve import beyond, separated
 from .train import KIND, build_model
 
 
@@ -86,9 +84,8 @@ def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False, 
     moves, overlapping = np.zeros((len(placed), 2)), []
     if resolve and resolve["enabled"]:
         floor = [k for k, inst in enumerate(insts) if inst is not None and k not in on]
-        beyond = from_corners(outside_pieces(room.outline, rect), 0.0, 2 * float(room.height))
         moves, overlapping = separated(retrieved_boxes(placed, insts, on), floor, rect, resolve["margin"],
-                                       resolve["max_moves"], beyond)
+                                       resolve["max_moves"], beyond(room, rect))
     out, ids, parents, drops = with_objects(room, []), {}, {}, []
     for k, (label, _, box) in enumerate(placed):
         inst = insts[k]

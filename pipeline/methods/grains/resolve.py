@@ -15,23 +15,35 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...geometry.boxes import clearing_moves, footprint_corners, penetration_depths
+from ...geometry.boxes import clearing_moves, footprint_corners, from_corners, penetration_depths
+from ...geometry.polygon import outside_pieces
+from ...room import RoomInput
+
+
+def bound(box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(2,)`` lower and upper corners (m) of the axis-aligned bound of the footprint of ``box (7,)``."""
+    c = footprint_corners(box[0], box[1], box[3], box[4], box[6])[0]
+    return c.min(0), c.max(0)
 
 
 def outside(box: np.ndarray, rect: tuple[float, float, float, float]) -> float:
     """How far (m) the footprint of ``box (7,)`` reaches beyond ``rect = (xmin, ymin, xmax, ymax)`` (0: inside)."""
-    c = footprint_corners(box[0], box[1], box[3], box[4], box[6])[0]
-    lo, hi = np.array(rect[:2]) - c.min(0), c.max(0) - np.array(rect[2:])
-    return float(max(lo.max(), hi.max(), 0.0))
+    lo, hi = bound(box)
+    return float(max((np.array(rect[:2]) - lo).max(), (hi - np.array(rect[2:])).max(), 0.0))
 
 
 def inside_move(box: np.ndarray, rect: tuple[float, float, float, float]) -> np.ndarray:
     """``(2,)`` the shortest move that brings the footprint of ``box (7,)`` inside ``rect`` on each axis it fits along
     (centred on an axis it does not fit along)."""
-    c = footprint_corners(box[0], box[1], box[3], box[4], box[6])[0]
-    lo, hi, rlo, rhi = c.min(0), c.max(0), np.array(rect[:2]), np.array(rect[2:])
+    (lo, hi), rlo, rhi = bound(box), np.array(rect[:2]), np.array(rect[2:])
     fits = hi - lo <= rhi - rlo
     return np.where(fits, np.maximum(rlo - lo, 0.0) - np.maximum(hi - rhi, 0.0), (rlo + rhi - lo - hi) / 2)
+
+
+def beyond(room: RoomInput, rect: tuple[float, float, float, float]) -> np.ndarray:
+    """``(m, 7)`` the parts of ``rect`` outside the room as boxes twice the room's height
+    (:func:`~pipeline.geometry.polygon.outside_pieces`): what :func:`separated` keeps objects off."""
+    return from_corners(outside_pieces(room.outline, rect), 0.0, 2 * float(room.height))
 
 
 def depths(kept: np.ndarray, box: np.ndarray) -> np.ndarray:
