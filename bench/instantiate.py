@@ -46,6 +46,7 @@ from pipeline.placement.anchors import anchors_of
 from pipeline.placement.layout import wall_frame, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Grid, Request, nearest_wall
+from pipeline.room.walkability import walkable_share
 from pipeline.seeding import seed_of
 
 from common import ROOT, arguments, corpus_paths, report, search_flags, search_overrides, search_suffix
@@ -139,7 +140,8 @@ def main() -> None:
         cfg["instantiate"]["density_cache"] = args.density_cache
     saved = checkpoint.load(Path("results/placement") / args.room_type / args.location / "model.pt",
                             instantiate.checkpoint_kind(args.location))
-    ctx = load_context(cfg, corpus_of(cfg, args.room_type), cfg["instantiate"]["wall_bound_share"])  # as PlanIT's search
+    ctx = load_context(cfg, corpus_of(cfg, args.room_type), cfg["instantiate"]["wall_bound_share"],
+                       walkable=True)  # as PlanIT's search
     if args.no_confirm:
         ctx.checker = replace(ctx.checker, cfg={**ctx.checker.cfg, "confirm": None})  # a fresh collision_test
     variant = {**cfg["instantiate"]["variants"]["planit"], "location": args.location, "graphs": args.graphs}
@@ -184,6 +186,9 @@ def main() -> None:
               "functional_placed": {k: round(float(v), 3) for k, v in
                                     pd.DataFrame(functional).mean().items()} if functional else None,
               **selection(ctx.corpus, plans[:len(rows)], rooms),
+              "walkable_share": round(float(np.mean([walkable_share(r, cfg["evaluate"]["walk"]) for r in rooms])), 4)
+              if rooms else None,
+              "walkable_under_0.8": sum(walkable_share(r, cfg["evaluate"]["walk"]) < 0.8 for r in rooms),
               "off_axis_share": axis["all"], "off_axis_share_training": train_axis["all"],
               "off_axis_gap": off_axis_gap(axis, train_axis, cfg["evaluate"]["off_axis_min_objects"]),
               **(probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker) if args.location != "prior" else {}),

@@ -7,9 +7,10 @@ import os
 import numpy as np
 import pytest
 
-from pipeline.evaluation import distributions, physical, render, walkability
+from pipeline.evaluation import distributions, physical, render
 from pipeline.geometry.collision import CollisionTest
 from pipeline.geometry.raycast import intersector_class
+from pipeline.room import walkability
 from pipeline.stage import Files
 
 from conftest import Room, default_config, l_sofa_mesh

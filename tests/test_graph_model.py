@@ -262,7 +262,7 @@ def test_extraction_and_refinement_never_import_torch():
             "pipeline.graphs.checks, pipeline.evaluation.graphs, pipeline.methods.planit.nets.data, "
             "pipeline.placement.search, pipeline.placement.checks, pipeline.placement.export, "
             "pipeline.placement.scene_metrics, pipeline.stages.instantiate, pipeline.stages.generate, "
-            "pipeline.evaluation.distributions, pipeline.evaluation.physical, pipeline.evaluation.walkability, "
+            "pipeline.evaluation.distributions, pipeline.evaluation.physical, pipeline.room.walkability, "
             "pipeline.evaluation.render, pipeline.stages.evaluate; "
             "assert 'torch' not in sys.modules, 'torch'")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

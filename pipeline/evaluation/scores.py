@@ -10,8 +10,9 @@ import pandas as pd
 from ..geometry.collision import CollisionTest
 from ..geometry.raycast import intersector_class
 from ..log import progress
+from ..room import walkability
 from ..seeding import rng_for
-from . import distributions, physical, render, walkability
+from . import distributions, physical, render
 from .sets import RoomSet
 
 if TYPE_CHECKING:

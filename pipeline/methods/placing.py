@@ -17,6 +17,7 @@ from ..placement.checks import Checker, checks_config
 from ..placement.plan import ScenePlan
 from ..placement.retrieval import ModelPool
 from ..placement.support import learn_support_floor
+from ..placement.walkable import learn_walkable_floor
 from ..placement.walls import learn_wall_bound
 from .interface import Corpus, Scene
 
@@ -33,10 +34,11 @@ class Context:
     partners: dict = field(default_factory=dict)  # facing partners the search orders by (facing_first); {}: PlanIT's order
 
 
-def load_context(config: dict, corpus: Corpus, wall_bound_share: float = 0.0) -> Context:
+def load_context(config: dict, corpus: Corpus, wall_bound_share: float = 0.0, walkable: bool = False) -> Context:
     """The room type's model pool, checker (with the support shares learned from the training rooms and, for PlanIT's
     search, the categories it keeps at their planned walls: ``wall_bound_share``, its ``instantiate.wall_bound_share``;
-    0: none, for the methods with placements of their own) and mean areas."""
+    0: none, for the methods with placements of their own; and with ``walkable`` the least walkable share a floor
+    object may leave, :mod:`pipeline.placement.walkable`) and mean areas."""
     sym_rows = tables.read(corpus.symmetry, "symmetry", columns=["model_id", "symmetry"]).to_pylist()
     sym = {r["model_id"]: r["symmetry"] for r in sym_rows}
     sizes = tables.read(corpus.category_sizes, "category_sizes").to_pandas()
@@ -50,12 +52,16 @@ def load_context(config: dict, corpus: Corpus, wall_bound_share: float = 0.0) ->
         snap = config["instantiate"]["snap"]
         bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
                                  wall_bound_share, snap["centre_min_pairs"], config["floor_contact"])
+    least = learn_walkable_floor(training, checks["walk"], checks["walkable"]) if walkable else 0.0
     checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor,
-                      bound)
+                      bound, walkable_floor=least)
     if floor:
         log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
     if bound:
         log.info("%s: categories kept at their planned walls: %s", corpus.room_type, sorted(bound))
+    if least:
+        log.info("%s: a floor object may not leave less than %.3f of the free floor connected to a door",
+                 corpus.room_type, least)
     objs = corpus.objects
     pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
     return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))

@@ -16,6 +16,7 @@ from ..geometry.collision import CollisionTest, deepest_penetration
 from ..geometry.polygon import door_zones, outside_area
 from ..room import RoomInput
 from .plan import PlanEdge
+from .walkable import closes_floor
 
 AREA_EPS = 1e-4  # m^2: overlaps of polygons under 1 cm^2 are numerical
 
@@ -33,9 +34,9 @@ class Verdict:
 def checks_config(config: dict) -> dict:
     """The ``instantiate.checks`` thresholds with the evaluation's penetration measure as ``confirm``: a pair the
     coarse per-attempt grid clears is measured again the way the evaluation measures it (no second measure when the
-    per-attempt measure is the evaluation's)."""
+    per-attempt measure is the evaluation's); and the evaluation's walkability settings as ``walk``."""
     own, evaluation = config["instantiate"]["checks"], config["evaluate"]["collision"]["penetration"]
-    return {**own, "confirm": None if own["penetration"] == evaluation else evaluation}
+    return {**own, "confirm": None if own["penetration"] == evaluation else evaluation, "walk": config["evaluate"]["walk"]}
 
 
 def required_support(min_support: float, support_floor: dict[str, float], category: str) -> float:
@@ -58,6 +59,7 @@ class Checker:
     support_floor: dict = field(default_factory=dict)  # category -> learned lower min_support (placement/support.py)
     wall_bound: frozenset = frozenset()  # categories whose planned wall adjacency is never broken (placement/walls.py)
     weighted: bool = False  # an object's relation cost weighs each edge by its plan weight (instantiate.weighted_relations)
+    walkable_floor: float = 0.0  # least door-connected share of free floor a floor object may leave (placement/walkable.py; 0: none)
 
     @cached_property
     def collision_test(self) -> CollisionTest:
@@ -195,6 +197,10 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
         hit = collision(room, k, related, checker)
         if hit is not None:
             return collides(room, hit)
+    if parent is None and checker.walkable_floor > 0:
+        closed = closes_floor(room, k, checker.walkable_floor, checker.cfg["walk"], checker.cfg["walkable"]["tolerance"])
+        if closed is not None:
+            return Verdict(False, f"closes the floor off from the door (walkable share {closed[0]:.2f} -> {closed[1]:.2f})", cost)
     return Verdict(True, cost=cost, edge_costs=list(zip(planned, costs)), found=found)
 
 

@@ -8,11 +8,11 @@ from functools import partial
 import numpy as np
 import shapely
 
-from ...evaluation.walkability import walkability
 from ...geometry import boxes as gb
 from ...geometry.polygon import nearest_segment
 from ...placement.checks import AREA_EPS
 from ...placement.retrieval import ModelPool
+from ...room.walkability import walkability
 from ..solver import operators as op
 from ..solver.moves import Spec
 from ..solver.state import State, wall_yaw

@@ -194,7 +194,7 @@ class PlanitLayout:
     def generate(self, task: Task) -> Iterator[Scene]:
         torch.set_num_threads(task.threads)
         saved = checkpoint.load(task.model, checkpoint_kind(self.variant["location"]))
-        ctx = load_context(self.config, task.corpus, self.settings["wall_bound_share"])
+        ctx = load_context(self.config, task.corpus, self.settings["wall_bound_share"], walkable=True)
         count = task.count or scene_count(self.config["instantiate"], self.variant)
         draws = self.settings["graph_draws"] if self.variant["graphs"] == "sampled" else 1
         plans = select_plans(self.config, self.variant, task.corpus, *task.graphs, count * draws)
@@ -233,7 +233,7 @@ class CompleteRoom:
         if not 0 <= self.keep <= len(plan.ids):
             raise InputError(f"keep: {self.keep}, but room {self.room} has {len(plan.ids)} objects")
         saved = checkpoint.load(task.model, KIND)
-        ctx = load_context(self.config, task.corpus, self.config["instantiate"]["wall_bound_share"])
+        ctx = load_context(self.config, task.corpus, self.config["instantiate"]["wall_bound_share"], walkable=True)
         ctx, proposer = search_kit(self.config, ctx, "cfcn", saved, self.config["instantiate"])
         seed = seed_of(self.config["seed"], "complete", plan.scene_id)
         outcome, walls = place_scene(plan, ctx, proposer, self.config["instantiate"], self.variant, seed, self.keep)

@@ -1,6 +1,8 @@
 """Walkability (PhyScene's measure): the floor minus the footprints of the objects an agent cannot pass under,
 eroded by the agent's radius, as a grid; the share of that free space connected to a door, and whether every floor
-object's front can be reached from a door. SciPy's ndimage does the erosion, labelling and distances."""
+object's front can be reached from a door. SciPy's ndimage does the erosion, labelling and distances. One measure
+for the evaluation, PlanIT's search (a floor object may not close the floor off from the door:
+``placement/walkable.py``) and the Infinigen-style solver's free-floor term."""
 from __future__ import annotations
 
 from typing import Any
@@ -10,7 +12,7 @@ from scipy import ndimage
 
 from ..geometry import boxes
 from ..geometry.raster import fill_polygon, fill_quads, pixel_centres
-from ..room import RoomInput
+from .model import RoomInput
 
 
 def walk_grid(room: RoomInput, cell: float, clearance: float) -> tuple[np.ndarray, float, np.ndarray]:
@@ -58,12 +60,23 @@ def front_points(room: RoomInput, clearance: float) -> tuple[np.ndarray, np.ndar
     return idx, np.einsum("nij,nj->ni", boxes.rotation(b[idx, 6]), local) + b[idx, :2]
 
 
+def connected_share(agent: np.ndarray, connected: np.ndarray) -> float:
+    """The door-connected share of the agent's free centres (none free: 0)."""
+    return float(connected.sum() / agent.sum()) if agent.any() else 0.0
+
+
+def walkable_share(room: RoomInput, cfg: dict[str, Any]) -> float:
+    """The door-connected share of the agent's free space alone (``cfg``: the ``evaluate.walk`` settings)."""
+    free, cell, centre = walk_grid(room, cfg["cell"], cfg["clearance"])
+    return connected_share(*door_connected(free, room, cell, centre, cfg["robot_radius"], cfg["door_reach"]))
+
+
 def walkability(room: RoomInput, cfg: dict[str, Any]) -> dict[str, Any]:
     """``walkable_share``: door-connected share of the agent's free space; ``reachable``: share of floor objects
     whose front midpoint lies within ``front_reach`` of a door-connected agent centre; ``all_reachable``."""
     free, cell, centre = walk_grid(room, cfg["cell"], cfg["clearance"])
     agent, connected = door_connected(free, room, cell, centre, cfg["robot_radius"], cfg["door_reach"])
-    share = float(connected.sum() / agent.sum()) if agent.any() else 0.0
+    share = connected_share(agent, connected)
     idx, fronts = front_points(room, cfg["clearance"])
     if not connected.any() or not len(idx):
         ok = np.zeros(len(idx), bool)

@@ -1,0 +1,70 @@
+"""A floor object may not close the floor off from the door (pipeline/placement/walkable.py): hand-built rooms
+with known answers, the real extraction and collision checks of PlanIT's search, and the evaluation's measure."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from pipeline.geometry.raycast import intersector_class
+from pipeline.placement.checks import Checker, check, checks_config
+from pipeline.placement.walkable import closes_floor, learn_walkable_floor
+from pipeline.room.walkability import walkability, walkable_share
+
+from conftest import Room, default_config
+
+SOFA, ARMCHAIR = (0.9, 2.2, 0.8), (1.0, 0.8, 0.8)
+
+
+def pocket_room(armchair_at: tuple[float, float] | None) -> Room:
+    """A 4 x 3.5 m room, its door in the left wall near the floor's corner (y 0.2-1.0), a sofa standing along x = 1.5
+    from the bottom wall up to y = 2.2, and an armchair at ``armchair_at``: at (0.7, 2.65) it closes the gap between
+    the sofa's end and the left wall, and the door opens onto a 1 m wide pocket."""
+    r = Room([(0, 0), (4, 0), (4, 3.5), (0, 3.5)]).door("d0", (0, 0.2), (0, 1.0), "wall_3")
+    r.add("sofa", "sofa", SOFA, (1.5, 1.1))
+    if armchair_at is not None:
+        r.add("armchair", "armchair", ARMCHAIR, armchair_at)
+    return r
+
+
+def checker_for(r: Room, floor: float) -> Checker:
+    cfg = default_config()
+    ext = {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
+    return Checker(r.models, set(r.models), {}, ext, intersector_class("embree"), checks_config(cfg), walkable_floor=floor)
+
+
+def test_an_armchair_that_walls_the_door_into_a_pocket_is_refused_and_one_elsewhere_is_not():
+    walk = default_config()["evaluate"]["walk"]
+    open_room = pocket_room(None).room_input()
+    closed = pocket_room((0.7, 2.65))
+    assert walkable_share(open_room, walk) > 0.99
+    share = walkable_share(closed.room_input(), walk)
+    assert share < 0.35  # only the pocket (about 1 x 2 m of some 12 m^2) is reached from the door
+    assert share == pytest.approx(walkability(closed.room_input(), walk)["walkable_share"])  # one measure
+    verdict = check(closed.room_input(), 1, None, set(), [], 0.0, checker_for(closed, 0.8))
+    assert not verdict.ok and verdict.reason.startswith("closes the floor off from the door")
+    aside = pocket_room((3.3, 2.9))
+    assert check(aside.room_input(), 1, None, set(), [], 0.0, checker_for(aside, 0.8)).ok
+    assert check(closed.room_input(), 1, None, set(), [], 0.0, checker_for(closed, 0.0)).ok  # no floor: no check
+
+
+def test_a_room_already_under_the_floor_takes_an_object_that_does_not_make_it_worse():
+    walk = default_config()["evaluate"]["walk"]
+    closed = pocket_room((0.7, 2.65)).add("stool", "stool", (0.4, 0.4, 0.45), (3.2, 0.6))  # in the walled-off part
+    room = closed.room_input()
+    assert walkable_share(room, walk) < 0.8
+    assert closes_floor(room, 2, 0.8, walk, 0.01) is None
+    before, after = closes_floor(room, 1, 0.8, walk, 0.01)  # the armchair still closes the pocket
+    assert after < 0.35 < 0.99 < before
+
+
+def test_the_least_share_is_the_training_rooms_quantile():
+    walk, cfg = default_config()["evaluate"]["walk"], default_config()["instantiate"]["checks"]["walkable"]
+    rooms = [pocket_room(None).room_input(), pocket_room((0.7, 2.65)).room_input(), pocket_room((3.3, 2.9)).room_input()]
+    shares = sorted(walkable_share(r, walk) for r in rooms)
+    assert learn_walkable_floor(rooms, walk, {**cfg, "quantile": 0.0}) == pytest.approx(shares[0], abs=1e-3)
+    assert learn_walkable_floor(rooms, walk, {**cfg, "quantile": 0.5}) == pytest.approx(shares[1], abs=1e-3)
+    assert learn_walkable_floor(rooms, walk, {**cfg, "enabled": False}) == 0.0
+    assert learn_walkable_floor([], walk, cfg) == 0.0
+    no_door = replace(rooms[1], openings=[])  # no door: the largest free component stands in for the door's
+    assert walkable_share(no_door, walk) > 0.6
