@@ -30,7 +30,8 @@ def pocket_room(armchair_at: tuple[float, float] | None) -> Room:
 def checker_for(r: Room, floor: float) -> Checker:
     cfg = default_config()
     ext = {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
-    return Checker(r.models, set(r.models), {}, ext, intersector_class("embree"), checks_config(cfg), walkable_floor=floor)
+    checks = {**checks_config(cfg), "walk": cfg["evaluate"]["walk"]}  # as methods/placing.load_context gives PlanIT's search
+    return Checker(r.models, set(r.models), {}, ext, intersector_class("embree"), checks, walkable_floor=floor)
 
 
 def test_an_armchair_that_walls_the_door_into_a_pocket_is_refused_and_one_elsewhere_is_not():

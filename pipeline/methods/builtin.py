@@ -56,10 +56,11 @@ def _solver_keys(section: str):
 
 def search_keys(config: dict, name: str) -> list[str]:
     """The keys PlanIT's search reads for one variant: every instantiate key but the variants (its own variant's
-    spec only, so adding another variant reruns nothing), the extraction and the evaluation's penetration measure
-    its collision check confirms with."""
+    spec only, so adding another variant reruns nothing), the extraction, the evaluation's penetration measure its
+    collision check confirms with and the walkability measure a floor object may not lower too far."""
     own = [f"instantiate.{k}" for k in config["instantiate"] if k not in ("variants", "table3_room_types")]
-    return ["seed", "extract", "floor_contact", *own, f"instantiate.variants.{name}", "evaluate.collision.penetration"]
+    return ["seed", "extract", "floor_contact", *own, f"instantiate.variants.{name}", "evaluate.collision.penetration",
+            "evaluate.walk"]
 
 
 def search_scenes(config: dict, name: str) -> int:

@@ -52,7 +52,10 @@ def load_context(config: dict, corpus: Corpus, wall_bound_share: float = 0.0, wa
         snap = config["instantiate"]["snap"]
         bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
                                  wall_bound_share, snap["centre_min_pairs"], config["floor_contact"])
-    least = learn_walkable_floor(training, checks["walk"], checks["walkable"]) if walkable else 0.0
+    least = 0.0
+    if walkable:  # the evaluation's walkability measure (evaluate.walk: a key of PlanIT's search, builtin.search_keys)
+        checks = {**checks, "walk": config["evaluate"]["walk"]}
+        least = learn_walkable_floor(training, checks["walk"], checks["walkable"])
     checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor,
                       bound, walkable_floor=least)
     if floor:

@@ -34,9 +34,9 @@ class Verdict:
 def checks_config(config: dict) -> dict:
     """The ``instantiate.checks`` thresholds with the evaluation's penetration measure as ``confirm``: a pair the
     coarse per-attempt grid clears is measured again the way the evaluation measures it (no second measure when the
-    per-attempt measure is the evaluation's); and the evaluation's walkability settings as ``walk``."""
+    per-attempt measure is the evaluation's)."""
     own, evaluation = config["instantiate"]["checks"], config["evaluate"]["collision"]["penetration"]
-    return {**own, "confirm": None if own["penetration"] == evaluation else evaluation, "walk": config["evaluate"]["walk"]}
+    return {**own, "confirm": None if own["penetration"] == evaluation else evaluation}
 
 
 def required_support(min_support: float, support_floor: dict[str, float], category: str) -> float:
@@ -59,7 +59,7 @@ class Checker:
     support_floor: dict = field(default_factory=dict)  # category -> learned lower min_support (placement/support.py)
     wall_bound: frozenset = frozenset()  # categories whose planned wall adjacency is never broken (placement/walls.py)
     weighted: bool = False  # an object's relation cost weighs each edge by its plan weight (instantiate.weighted_relations)
-    walkable_floor: float = 0.0  # least door-connected share of free floor a floor object may leave (placement/walkable.py; 0: none)
+    walkable_floor: float = 0.0  # least walkable share a floor object may leave (placement/walkable.py; cfg["walk"]; 0: none)
 
     @cached_property
     def collision_test(self) -> CollisionTest:
