@@ -28,7 +28,7 @@ from pipeline.geometry.boxes import penetration_depths
 from pipeline.learning import checkpoint
 from pipeline.methods.grains.hierarchy import Node, anchor, decoded_room, layout, leaves, room_rect
 from pipeline.methods.grains.layout import retrieved_boxes, root_of, supports
-from pipeline.methods.grains.resolve import beyond, separated
+from pipeline.methods.grains.resolve import kept_clear, separated
 from pipeline.methods.grains.train import KIND, build_model
 from pipeline.methods.placing import load_context
 from pipeline.placement.retrieval import nearest, nearest_within
@@ -134,8 +134,9 @@ def main() -> None:
                 insts = [pick(ctx.pool, label, box[3:6]) for label, _, box in placed]
                 got, rect = retrieved_boxes(placed, insts, on), room_rect(room)
                 floor = [k for k, inst in enumerate(insts) if inst is not None and k not in on]
-                moves, left_out = separated(got, floor, rect, limit, cfg["grains"]["resolve"]["max_moves"],
-                                            beyond(room, rect))
+                res = cfg["grains"]["resolve"]
+                clear = kept_clear(room, rect, cfg["instantiate"]["checks"]["door_clearance"] if res["doors"] else 0.0)
+                moves, left_out = separated(got, floor, rect, limit, res["max_moves"], clear)
                 got[:, :2] += moves[[root_of(k, on) for k in range(len(got))]]
                 kept = np.array([k for k in range(len(got)) if k not in left_out and root_of(k, on) not in left_out], int)
                 kept_on = {int(np.searchsorted(kept, c)): int(np.searchsorted(kept, p)) for c, p in on.items() if c in kept}

@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from pipeline.geometry.boxes import footprint_corners
 from pipeline.methods.grains.hierarchy import build_tree, decoded_room
 from pipeline.methods.grains.layout import furnish, supports
 from pipeline.placement.retrieval import ModelPool
@@ -89,7 +90,8 @@ def test_within_retrieval_furnishes_the_source_room_back():
     assert sorted(got.model_ids) == sorted(room.model_ids)
 
 
-RESOLVE = {"enabled": True, "margin": 0.01, "max_moves": 8}  # margin: the placement checks' collision depth
+RESOLVE = {"enabled": True, "margin": 0.01, "max_moves": 8, "doors": True,  # margin: the checks' collision depth
+           "door_clearance": 0.6}  # the placement checks' door clearance
 
 
 def _floor_penetration(room) -> float:
@@ -183,6 +185,31 @@ def test_objects_through_the_walls_come_back_inside_and_off_an_l_shaped_rooms_mi
     at = {c: got.boxes[got.categories.index(c)] for c in got.categories}
     assert drops == [] and np.allclose(at["bed"][:2], raw.boxes[raw.categories.index("bed")][:2])
     assert np.allclose(at["dresser"][:2], [0.6, 2.0 - 0.3], atol=1e-6)
+
+
+def test_a_group_laid_in_front_of_the_held_out_rooms_door_moves_off_its_zone_and_the_floor_reaches_the_door():
+    """GRAINS's own rooms have no doors: a bed decoded against the bottom wall of a 4 x 3 m room (x 0.2-1.8, y 0-2)
+    covers the held-out room's door there (x 0.9-1.7). Raw, the door opens onto the bed and no floor is reached from
+    it; repaired, the bed takes the shortest clearing move off the door's 0.6 m zone (0.6 m up: 0.9 m right is
+    longer, left leaves the room), so the door's zone is clear and the floor is reached from it; with ``doors`` off
+    the bed stays."""
+    from pipeline.config import validate
+    from pipeline.placement.checks import blocks_door
+    from pipeline.room.walkability import walkable_share
+
+    outline = np.array([[0, 0], [4, 0], [4, 3], [0, 3]], float)
+    source = make_room(outline, [("bed", "bed", box(1.0, 1.0, 0.8, 1.0, 0.3))])
+    door = {"element_id": "d", "kind": "door", "x0": 0.9, "y0": 0.0, "x1": 1.7, "y1": 0.0, "z0": 0.0, "z1": 2.0}
+    into = replace(make_room(outline, []), openings=[door])
+    tree, walk = build_tree(source, {"bed": None}), validate({})["evaluate"]["walk"]
+    raw, _, _ = furnish(tree, into, pool_of(source), "s")
+    got, _, drops = furnish(tree, into, pool_of(source), "s", resolve=RESOLVE)
+    kept, _, _ = furnish(tree, into, pool_of(source), "s", resolve={**RESOLVE, "doors": False})
+    corners = footprint_corners(*got.boxes[0, [0, 1, 3, 4, 6]])[0]
+    assert blocks_door(raw, footprint_corners(*raw.boxes[0, [0, 1, 3, 4, 6]])[0], 0.6) and walkable_share(raw, walk) == 0.0
+    assert drops == [] and np.allclose(got.boxes[0, :2], raw.boxes[0, :2] + [0.0, 0.6], atol=1e-6)
+    assert not blocks_door(got, corners, 0.6 - 0.011) and walkable_share(got, walk) > 0.95
+    assert np.allclose(kept.boxes[0, :2], raw.boxes[0, :2])
 
 
 @pytest.mark.realdata

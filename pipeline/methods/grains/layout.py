@@ -25,7 +25,7 @@ from ...seeding import seed_of
 from ..interface import Scene, Task
 from ..placing import load_context
 from .hierarchy import Node, anchor, decoded_room, layout, leaves, room_rect
-from .resolve import beyond, separated
+from .resolve import kept_clear, separated
 from .train import KIND, build_model
 
 
@@ -73,9 +73,10 @@ def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False, 
     unrecorded (the training split lacks them). ``snap``: the codes' bits win over their reals
     (:func:`.relpos.decode`); ``retrieval``: ``nearest`` (GRAINS's) or ``within`` (the nearest whose footprint fits the
     decoded one, :func:`~pipeline.placement.retrieval.nearest_within`); ``resolve``: ``grains.resolve`` with the
-    collision depth as ``margin`` (enabled: floor objects moved inside the room's rectangle and off each other and
-    off what of the rectangle lies outside the room, :func:`.resolve.separated`; one still colliding is left out, cause
-    ``overlap``, with what stands on it, cause ``support_dropped``)."""
+    collision depth as ``margin`` and the door clearance as ``door_clearance`` (enabled: floor objects moved inside the
+    room's rectangle and off each other, off what of the rectangle lies outside the room and, with ``doors``, off the
+    zone inside each door, :func:`.resolve.separated`; one still colliding is left out, cause ``overlap``, with what
+    stands on it, cause ``support_dropped``)."""
     rect = room_rect(room)
     placed = layout(tree, rect, snap)
     on = supports(tree)
@@ -84,8 +85,9 @@ def furnish(tree: Node, room, pool: ModelPool, prefix: str, snap: bool = False, 
     moves, overlapping = np.zeros((len(placed), 2)), []
     if resolve and resolve["enabled"]:
         floor = [k for k, inst in enumerate(insts) if inst is not None and k not in on]
+        fixed = kept_clear(room, rect, resolve["door_clearance"] if resolve["doors"] else 0.0)
         moves, overlapping = separated(retrieved_boxes(placed, insts, on), floor, rect, resolve["margin"],
-                                       resolve["max_moves"], beyond(room, rect))
+                                       resolve["max_moves"], fixed)
     out, ids, parents, drops = with_objects(room, []), {}, {}, []
     for k, (label, _, box) in enumerate(placed):
         inst = insts[k]
@@ -116,8 +118,9 @@ class GrainsLayout:
     def __init__(self, config: dict, name: str):
         self.config, self.name, self.cfg = config, name, config["grains"]
         self.retrieval = "nearest" if self.faithful else self.cfg["retrieval"]
-        self.resolve = None if self.faithful else {**self.cfg["resolve"],
-                                                    "margin": config["instantiate"]["checks"]["collision"]}
+        checks = config["instantiate"]["checks"]
+        self.resolve = None if self.faithful else {**self.cfg["resolve"], "margin": checks["collision"],
+                                                    "door_clearance": checks["door_clearance"]}
         self.info = {"max_depth": self.cfg["max_depth"], "snap": self.cfg["snap"], "rooms": self.rooms_info,
                      "retrieval": self.retrieval, "resolve": self.resolve}
 

@@ -10,13 +10,15 @@ footprint first: each is first moved inside the room's rectangle, then, if it pe
 the part of the rectangle outside an L-shaped room), takes the shortest of the clearing moves
 (:func:`~pipeline.geometry.boxes.clearing_moves`) that leaves the least penetration with everything kept and takes it
 no further out of the rectangle; an object still colliding after ``max_moves`` moves is left out (recorded by the
-caller). Objects on a support move with it."""
+caller). Objects on a support move with it. GRAINS's own rooms have no doors; laid onto a held-out room's walls, a
+group can stand in front of its door, so the zone inside each door (the placement checks' door clearance) is kept
+clear the same way (``grains.resolve.doors``)."""
 from __future__ import annotations
 
 import numpy as np
 
 from ...geometry.boxes import clearing_moves, footprint_corners, from_corners, penetration_depths
-from ...geometry.polygon import outside_pieces
+from ...geometry.polygon import door_zones, outside_pieces
 from ...room import RoomInput
 
 
@@ -44,6 +46,21 @@ def beyond(room: RoomInput, rect: tuple[float, float, float, float]) -> np.ndarr
     """``(m, 7)`` the parts of ``rect`` outside the room as boxes twice the room's height
     (:func:`~pipeline.geometry.polygon.outside_pieces`): what :func:`separated` keeps objects off."""
     return from_corners(outside_pieces(room.outline, rect), 0.0, 2 * float(room.height))
+
+
+def door_zones_of(room: RoomInput, depth: float) -> np.ndarray:
+    """``(d, 7)`` the zones ``depth`` m deep inside each door of ``room`` (:func:`~pipeline.geometry.polygon.door_zones`,
+    the placement checks' door clearance) as boxes twice the room's height; none when ``depth`` is 0."""
+    doors = [[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in room.openings if o["kind"] == "door"]
+    if depth <= 0 or not doors:
+        return np.zeros((0, 7))
+    return from_corners(door_zones(room.outline, np.array(doors, float), depth), 0.0, 2 * float(room.height))
+
+
+def kept_clear(room: RoomInput, rect: tuple[float, float, float, float], door_clearance: float) -> np.ndarray:
+    """``(m, 7)`` what :func:`separated` keeps objects off: the parts of ``rect`` outside the room (:func:`beyond`) and
+    the zones ``door_clearance`` m deep inside its doors (:func:`door_zones_of`; 0: none)."""
+    return np.vstack([beyond(room, rect), door_zones_of(room, door_clearance)])
 
 
 def depths(kept: np.ndarray, box: np.ndarray) -> np.ndarray:
