@@ -1,7 +1,7 @@
 """One run's evaluation, the figures issue 40 names, per room type for chosen methods beside the held-out real rooms:
 functional_all, the single functional check furthest from real (and its gap), graph consistency, relaxed share,
-collisions, the largest off-axis gap to the training rooms, category KL against its floor, SCA with the power check's
-verdict, median seconds per scene.
+collisions, the walkable share (door-connected share of the free floor), the largest off-axis gap to the training
+rooms, category KL against its floor, SCA with the power check's verdict, median seconds per scene.
 
     .venv/bin/python bench/eval_table.py RUN [--methods planit planit_prior] [--types bedroom living ...]
 
@@ -40,7 +40,8 @@ def row(name: str, entry: dict, real: dict, metrics: dict, median: float | None)
     fmt = lambda v, d=3: "-" if v is None else f"{v:.{d}f}"
     return (f"| {name} | {entry.get('scenes')}/{entry.get('attempted')} | {fmt(entry.get('functional_all'), 2)} | "
             f"{check} {-gap:+.2f} | {fmt(entry.get('consistency'))} | {fmt(entry.get('relaxed_share'))} | "
-            f"{fmt(entry.get('object_collision_rate'))} | {fmt(off, 2)} | {entry['category_kl'] / floor:.1f}x | "
+            f"{fmt(entry.get('object_collision_rate'))} | {fmt(entry.get('walkable_share'))} | {fmt(off, 2)} | "
+            f"{entry['category_kl'] / floor:.1f}x | "
             f"{fmt(sca.get('accuracy'), 1)} | {fmt(median, 2)} |")
 
 
@@ -51,15 +52,15 @@ def main() -> None:
     ap.add_argument("--types", nargs="+", default=["bedroom", "living", "office", "kitchen", "bathroom"])
     args = ap.parse_args()
     print("| set | scenes/attempted | functional_all | worst check vs real | consistency | relaxed | collisions | "
-          "off-axis gap | KL / floor | SCA % | median s/scene |")
-    print("|---" * 11 + "|")
+          "walkable | off-axis gap | KL / floor | SCA % | median s/scene |")
+    print("|---" * 12 + "|")
     for room_type in args.types:
         path = args.run / "results" / "eval" / room_type / "metrics.json"
         if not path.exists():
             continue
         metrics = json.loads(path.read_text())
         sets, real = metrics["sets"], metrics["sets"][REAL]
-        print(f"| **{room_type}** (power check {'passed' if metrics['power'].get('passed') else 'FAILED'}) |" + " |" * 10)
+        print(f"| **{room_type}** (power check {'passed' if metrics['power'].get('passed') else 'FAILED'}) |" + " |" * 11)
         for name in [*args.methods, REAL]:
             if name in sets:
                 print(row(name, sets[name], real, metrics, median_seconds(args.run, room_type, name)))

@@ -46,7 +46,7 @@ from pipeline.placement.anchors import anchors_of
 from pipeline.placement.layout import wall_frame, with_objects
 from pipeline.placement.plan import PlanEdge, ScenePlan
 from pipeline.placement.proposers import Grid, Request, nearest_wall
-from pipeline.room.walkability import walkable_share
+from pipeline.room.walkability import Walk, walkable_share
 from pipeline.seeding import seed_of
 
 from common import ROOT, arguments, corpus_paths, report, search_flags, search_overrides, search_suffix
@@ -170,6 +170,7 @@ def main() -> None:
             failing[plan.scene_id] = failed_checks(functional[-1])
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())
     placed = [r for r in rows if r[0]]
+    walk = Walk.of(cfg["evaluate"]["walk"])
     axis = off_axis_shares(rooms, sym, cfg["evaluate"]["off_axis_angle"])
     train_axis = off_axis_shares(ctx.corpus.training(), sym, cfg["evaluate"]["off_axis_angle"])
     result = {"room_type": args.room_type, "location": args.location, "graphs": args.graphs, "scenes": len(rows),
@@ -186,9 +187,8 @@ def main() -> None:
               "functional_placed": {k: round(float(v), 3) for k, v in
                                     pd.DataFrame(functional).mean().items()} if functional else None,
               **selection(ctx.corpus, plans[:len(rows)], rooms),
-              "walkable_share": round(float(np.mean([walkable_share(r, cfg["evaluate"]["walk"]) for r in rooms])), 4)
-              if rooms else None,
-              "walkable_under_0.8": sum(walkable_share(r, cfg["evaluate"]["walk"]) < 0.8 for r in rooms),
+              "walkable_share": round(float(np.mean([walkable_share(r, walk) for r in rooms])), 4) if rooms else None,
+              "walkable_under_0.8": sum(walkable_share(r, walk) < 0.8 for r in rooms),
               "off_axis_share": axis["all"], "off_axis_share_training": train_axis["all"],
               "off_axis_gap": off_axis_gap(axis, train_axis, cfg["evaluate"]["off_axis_min_objects"]),
               **(probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker) if args.location != "prior" else {}),

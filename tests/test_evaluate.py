@@ -81,7 +81,7 @@ def test_a_sampling_floor_of_identical_rooms_is_zero_and_of_mixed_rooms_positive
 
 
 def _walk(room: Room):
-    return walkability.walkability(room.room_input(), default_config()["evaluate"]["walk"])
+    return walkability.walkability(room.room_input(), walkability.Walk.of(default_config()["evaluate"]["walk"]))
 
 
 def test_a_wardrobe_in_front_of_the_door_makes_the_room_unwalkable():
@@ -169,7 +169,7 @@ def test_metrics_on_real_3d_front_rooms_are_finite_and_agree_with_the_filter(tmp
         on_mesh += physical.colliding(r, par, mesh, _collision_cfg("mesh")).sum()
         on_box += physical.colliding(r, par, mesh, _collision_cfg("box")).sum()
         oob = physical.out_of_bounds(r.outline, r.boxes, cfg["out_of_bounds"]["erode"], cfg["out_of_bounds"]["tolerance"])
-        walk = walkability.walkability(r, cfg["walk"])
+        walk = walkability.walkability(r, walkability.Walk.of(cfg["walk"]))
         assert oob.dtype == bool and len(oob) == len(r.object_ids)
         assert 0.0 <= walk["walkable_share"] <= 1.0 and 0.0 <= walk["reachable"] <= 1.0
     assert on_mesh < on_box

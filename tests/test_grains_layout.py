@@ -195,13 +195,13 @@ def test_a_group_laid_in_front_of_the_held_out_rooms_door_moves_off_its_zone_and
     the bed stays."""
     from pipeline.config import validate
     from pipeline.placement.checks import blocks_door
-    from pipeline.room.walkability import walkable_share
+    from pipeline.room.walkability import Walk, walkable_share
 
     outline = np.array([[0, 0], [4, 0], [4, 3], [0, 3]], float)
     source = make_room(outline, [("bed", "bed", box(1.0, 1.0, 0.8, 1.0, 0.3))])
     door = {"element_id": "d", "kind": "door", "x0": 0.9, "y0": 0.0, "x1": 1.7, "y1": 0.0, "z0": 0.0, "z1": 2.0}
     into = replace(make_room(outline, []), openings=[door])
-    tree, walk = build_tree(source, {"bed": None}), validate({})["evaluate"]["walk"]
+    tree, walk = build_tree(source, {"bed": None}), Walk.of(validate({})["evaluate"]["walk"])
     raw, _, _ = furnish(tree, into, pool_of(source), "s")
     got, _, drops = furnish(tree, into, pool_of(source), "s", resolve=RESOLVE)
     kept, _, _ = furnish(tree, into, pool_of(source), "s", resolve={**RESOLVE, "doors": False})

@@ -21,9 +21,10 @@ from pipeline.methods.solver.terms import Energy, Hard, Limits, Term
 from pipeline.placement.layout import walls_of
 from pipeline.placement.retrieval import ModelPool
 from pipeline.room import RoomInput
+from pipeline.room.walkability import Walk
 
 LIMITS = Limits(collision=0.01, outside=0.02, door=0.0, min_support=0.9)
-WALK = {"cell": 0.1, "robot_radius": 0.15, "clearance": 1.0, "door_reach": 0.3, "front_reach": 0.3}
+WALK = Walk(cell=0.1, robot_radius=0.15, clearance=1.0, door_reach=0.3, front_reach=0.3)
 
 
 def room(w: float, d: float) -> RoomInput:

@@ -8,12 +8,13 @@ import pytest
 
 from pipeline.geometry.raycast import intersector_class
 from pipeline.placement.checks import Checker, check, checks_config
-from pipeline.placement.walkable import closes_floor, learn_walkable_floor
-from pipeline.room.walkability import walkability, walkable_share
+from pipeline.placement.walkable import FloorKept, learn_walkable_floor
+from pipeline.room.walkability import Walk, walkability, walkable_share
 
 from conftest import Room, default_config
 
 SOFA, ARMCHAIR = (0.9, 2.2, 0.8), (1.0, 0.8, 0.8)
+WALK = Walk.of(default_config()["evaluate"]["walk"])
 
 
 def pocket_room(armchair_at: tuple[float, float] | None) -> Room:
@@ -27,21 +28,20 @@ def pocket_room(armchair_at: tuple[float, float] | None) -> Room:
     return r
 
 
-def checker_for(r: Room, floor: float) -> Checker:
+def checker_for(r: Room, least: float) -> Checker:
     cfg = default_config()
     ext = {"floor_contact": cfg["floor_contact"], **cfg["extract"]}
-    checks = {**checks_config(cfg), "walk": cfg["evaluate"]["walk"]}  # as methods/placing.load_context gives PlanIT's search
-    return Checker(r.models, set(r.models), {}, ext, intersector_class("embree"), checks, walkable_floor=floor)
+    kept = FloorKept(WALK, least, 0.01) if least > 0 else None
+    return Checker(r.models, set(r.models), {}, ext, intersector_class("embree"), checks_config(cfg), floor_kept=kept)
 
 
 def test_an_armchair_that_walls_the_door_into_a_pocket_is_refused_and_one_elsewhere_is_not():
-    walk = default_config()["evaluate"]["walk"]
     open_room = pocket_room(None).room_input()
     closed = pocket_room((0.7, 2.65))
-    assert walkable_share(open_room, walk) > 0.99
-    share = walkable_share(closed.room_input(), walk)
+    assert walkable_share(open_room, WALK) > 0.99
+    share = walkable_share(closed.room_input(), WALK)
     assert share < 0.35  # only the pocket (about 1 x 2 m of some 12 m^2) is reached from the door
-    assert share == pytest.approx(walkability(closed.room_input(), walk)["walkable_share"])  # one measure
+    assert share == pytest.approx(walkability(closed.room_input(), WALK)["walkable_share"])  # one measure
     verdict = check(closed.room_input(), 1, None, set(), [], 0.0, checker_for(closed, 0.8))
     assert not verdict.ok and verdict.reason.startswith("closes the floor off from the door")
     aside = pocket_room((3.3, 2.9))
@@ -50,22 +50,24 @@ def test_an_armchair_that_walls_the_door_into_a_pocket_is_refused_and_one_elsewh
 
 
 def test_a_room_already_under_the_floor_takes_an_object_that_does_not_make_it_worse():
-    walk = default_config()["evaluate"]["walk"]
     closed = pocket_room((0.7, 2.65)).add("stool", "stool", (0.4, 0.4, 0.45), (3.2, 0.6))  # in the walled-off part
-    room = closed.room_input()
-    assert walkable_share(room, walk) < 0.8
-    assert closes_floor(room, 2, 0.8, walk, 0.01) is None
-    before, after = closes_floor(room, 1, 0.8, walk, 0.01)  # the armchair still closes the pocket
+    room, kept = closed.room_input(), FloorKept(WALK, 0.8, 0.01)
+    assert walkable_share(room, WALK) < 0.8
+    assert kept.closes(room, 2) is None
+    before, after = kept.closes(room, 1)  # the armchair still closes the pocket
     assert after < 0.35 < 0.99 < before
 
 
 def test_the_least_share_is_the_training_rooms_quantile():
-    walk, cfg = default_config()["evaluate"]["walk"], default_config()["instantiate"]["checks"]["walkable"]
+    cfg = default_config()
+    walk, settings = cfg["evaluate"]["walk"], cfg["instantiate"]["checks"]["walkable"]
     rooms = [pocket_room(None).room_input(), pocket_room((0.7, 2.65)).room_input(), pocket_room((3.3, 2.9)).room_input()]
-    shares = sorted(walkable_share(r, walk) for r in rooms)
-    assert learn_walkable_floor(rooms, walk, {**cfg, "quantile": 0.0}) == pytest.approx(shares[0], abs=1e-3)
-    assert learn_walkable_floor(rooms, walk, {**cfg, "quantile": 0.5}) == pytest.approx(shares[1], abs=1e-3)
-    assert learn_walkable_floor(rooms, walk, {**cfg, "enabled": False}) == 0.0
-    assert learn_walkable_floor([], walk, cfg) == 0.0
+    shares = sorted(walkable_share(r, WALK) for r in rooms)
+    assert learn_walkable_floor(rooms, WALK, 0.0) == pytest.approx(shares[0], abs=1e-3)
+    assert learn_walkable_floor(rooms, WALK, 0.5) == pytest.approx(shares[1], abs=1e-3)
+    kept = FloorKept.learn(rooms, walk, {**settings, "quantile": 0.5})
+    assert kept is not None and kept.least == pytest.approx(shares[1], abs=1e-3) and kept.walk == WALK
+    assert FloorKept.learn(rooms, walk, {**settings, "enabled": False}) is None
+    assert FloorKept.learn([], walk, settings) is None
     no_door = replace(rooms[1], openings=[])  # no door: the largest free component stands in for the door's
-    assert walkable_share(no_door, walk) > 0.6
+    assert walkable_share(no_door, WALK) > 0.6

@@ -27,10 +27,11 @@ def scene_rows(rs: RoomSet, meshes: dict[str, Any], box_models: set[str], train_
     collision_test = CollisionTest.of(ev["collision"]["penetration"], ev["collision"]["max_penetration"],
                                       intersector_class(config["extract"]["backend"]))
     records = rs.scenes.set_index("scene_id") if rs.scenes is not None else None
+    measure = walkability.Walk.of(ev["walk"])
     rows = []
     for room, parents in progress(list(zip(rs.rooms, rs.parents)), desc=f"scoring {rs.name}"):
         mesh = [None if m in box_models else meshes.get(m) for m in room.model_ids]
-        walk = walkability.walkability(room, ev["walk"])
+        walk = walkability.walkability(room, measure)
         sim = render.similarity(render.label_map(room, index, ev["render"]["size"], ev["render"]["mpp"]), train_maps)
         sim[[k for k, t in enumerate(train_ids) if t == room.room_id]] = -1.0  # a training room is not its own neighbour
         nn = int(np.argmax(sim)) if len(sim) else None

@@ -17,7 +17,7 @@ from ..placement.checks import Checker, checks_config
 from ..placement.plan import ScenePlan
 from ..placement.retrieval import ModelPool
 from ..placement.support import learn_support_floor
-from ..placement.walkable import learn_walkable_floor
+from ..placement.walkable import FloorKept
 from ..placement.walls import learn_wall_bound
 from .interface import Corpus, Scene
 
@@ -52,19 +52,17 @@ def load_context(config: dict, corpus: Corpus, wall_bound_share: float = 0.0, wa
         snap = config["instantiate"]["snap"]
         bound = learn_wall_bound(training, snap["wall_back_gap"], np.radians(snap["wall_back_angle"]),
                                  wall_bound_share, snap["centre_min_pairs"], config["floor_contact"])
-    least = 0.0
-    if walkable:  # the evaluation's walkability measure (evaluate.walk: a key of PlanIT's search, builtin.search_keys)
-        checks = {**checks, "walk": config["evaluate"]["walk"]}
-        least = learn_walkable_floor(training, checks["walk"], checks["walkable"])
+    # the evaluation's walkability measure (evaluate.walk: a key of PlanIT's search only, builtin.search_keys)
+    kept = FloorKept.learn(training, config["evaluate"]["walk"], checks["walkable"]) if walkable else None
     checker = Checker(corpus.meshes, corpus.box_models, sym, ext, intersector_class(ext["backend"]), checks, floor,
-                      bound, walkable_floor=least)
+                      bound, floor_kept=kept)
     if floor:
         log.info("%s: support shares learned from the training rooms: %s", corpus.room_type, floor)
     if bound:
         log.info("%s: categories kept at their planned walls: %s", corpus.room_type, sorted(bound))
-    if least:
+    if kept:
         log.info("%s: a floor object may not leave less than %.3f of the free floor connected to a door",
-                 corpus.room_type, least)
+                 corpus.room_type, kept.least)
     objs = corpus.objects
     pool = ModelPool(objs[~objs["room_id"].isin(set(corpus.ids("heldout")))], sym, config["floor_contact"])
     return Context(corpus, pool, checker, dict(zip(sizes["category"].astype(str), sizes["mean_area"])))

@@ -16,7 +16,7 @@ from ..geometry.collision import CollisionTest, deepest_penetration
 from ..geometry.polygon import door_zones, outside_area
 from ..room import RoomInput
 from .plan import PlanEdge
-from .walkable import closes_floor
+from .walkable import FloorKept
 
 AREA_EPS = 1e-4  # m^2: overlaps of polygons under 1 cm^2 are numerical
 
@@ -59,7 +59,7 @@ class Checker:
     support_floor: dict = field(default_factory=dict)  # category -> learned lower min_support (placement/support.py)
     wall_bound: frozenset = frozenset()  # categories whose planned wall adjacency is never broken (placement/walls.py)
     weighted: bool = False  # an object's relation cost weighs each edge by its plan weight (instantiate.weighted_relations)
-    walkable_floor: float = 0.0  # least walkable share a floor object may leave (placement/walkable.py; cfg["walk"]; 0: none)
+    floor_kept: FloorKept | None = None  # the least walkable share a floor object may leave (placement/walkable.py)
 
     @cached_property
     def collision_test(self) -> CollisionTest:
@@ -197,8 +197,8 @@ def check(room: RoomInput, k: int, parent: int | None, children: set[int], plann
         hit = collision(room, k, related, checker)
         if hit is not None:
             return collides(room, hit)
-    if parent is None and checker.walkable_floor > 0:
-        closed = closes_floor(room, k, checker.walkable_floor, checker.cfg["walk"], checker.cfg["walkable"]["tolerance"])
+    if parent is None and checker.floor_kept is not None:
+        closed = checker.floor_kept.closes(room, k)
         if closed is not None:
             return Verdict(False, f"closes the floor off from the door (walkable share {closed[0]:.2f} -> {closed[1]:.2f})", cost)
     return Verdict(True, cost=cost, edge_costs=list(zip(planned, costs)), found=found)

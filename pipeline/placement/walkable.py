@@ -4,32 +4,44 @@ refuses a floor object leaving a room below it. PlanIT's search checks a door's 
 armchair can each keep it and together wall a pocket of the floor off from the door (docs/departures.md)."""
 from __future__ import annotations
 
-from dataclasses import replace
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..room import RoomInput
-from ..room.walkability import walkable_share
+from ..room.walkability import Walk, walkable_share
 
 
-def learn_walkable_floor(rooms: list[RoomInput], walk: dict[str, Any], cfg: dict[str, Any]) -> float:
-    """The ``cfg["quantile"]`` of the training ``rooms``' walkable shares (``walk``: the ``evaluate.walk``
-    settings; ``cfg``: ``instantiate.checks.walkable``); 0 (no check) when disabled or no room has a floor."""
-    if not cfg["enabled"] or not rooms:
-        return 0.0
+def learn_walkable_floor(rooms: list[RoomInput], walk: Walk, quantile: float) -> float:
+    """The ``quantile`` of the training ``rooms``' walkable shares; 0 (no check) when no room has a floor."""
     shares = [walkable_share(r, walk) for r in rooms if len(r.outline) >= 3]
-    return round(float(np.quantile(shares, cfg["quantile"])), 3) if shares else 0.0
+    return round(float(np.quantile(shares, quantile)), 3) if shares else 0.0
 
 
-def closes_floor(room: RoomInput, k: int, floor: float, walk: dict[str, Any], tolerance: float) -> tuple[float, float] | None:
-    """``(share before, share after)`` when floor object ``k`` of ``room`` leaves the door-connected share of the free
-    floor under ``floor`` and more than ``tolerance`` under what it was without the object; else None (a room
-    already under ``floor`` may still take objects that do not make it worse)."""
-    if floor <= 0:
-        return None
-    after = walkable_share(room, walk)
-    if after >= floor:
-        return None
-    before = walkable_share(replace(room, boxes=np.delete(room.boxes, k, axis=0)), walk)
-    return (before, after) if after < before - tolerance else None
+@dataclass(frozen=True)
+class FloorKept:
+    """The check: ``least`` walkable share a floor object may leave by the ``walk`` measure, and how much lower than
+    without it (``tolerance``) a room already under it may go."""
+    walk: Walk
+    least: float
+    tolerance: float
+
+    @classmethod
+    def learn(cls, rooms: list[RoomInput], walk: Mapping[str, Any], cfg: Mapping[str, Any]) -> "FloorKept | None":
+        """From the training ``rooms``, the ``evaluate.walk`` settings and ``instantiate.checks.walkable`` (None when
+        disabled or nothing is learned)."""
+        measure = Walk.of(walk)
+        least = learn_walkable_floor(rooms, measure, cfg["quantile"]) if cfg["enabled"] else 0.0
+        return cls(measure, least, float(cfg["tolerance"])) if least > 0 else None
+
+    def closes(self, room: RoomInput, k: int) -> tuple[float, float] | None:
+        """``(share before, share after)`` when floor object ``k`` of ``room`` leaves the walkable share under
+        ``least`` and more than ``tolerance`` under what it was without the object; else None (a room already under
+        ``least`` may still take objects that do not make it worse)."""
+        after = walkable_share(room, self.walk)
+        if after >= self.least:
+            return None
+        before = walkable_share(replace(room, boxes=np.delete(room.boxes, k, axis=0)), self.walk)
+        return (before, after) if after < before - self.tolerance else None

@@ -5,6 +5,8 @@ for the evaluation, PlanIT's search (a floor object may not close the floor off 
 ``placement/walkable.py``) and the Infinigen-style solver's free-floor term."""
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -13,6 +15,21 @@ from scipy import ndimage
 from ..geometry import boxes
 from ..geometry.raster import fill_polygon, fill_quads, pixel_centres
 from .model import RoomInput
+
+
+@dataclass(frozen=True)
+class Walk:
+    """The measure's settings (``evaluate.walk``), read once from the validated config."""
+    cell: float  # m, grid cell
+    robot_radius: float  # m, the agent's radius
+    clearance: float  # m; objects whose bottom is higher do not block
+    door_reach: float  # m beyond the radius from a door's midpoint that counts as at the door
+    front_reach: float  # m from an object's front midpoint to the nearest door-connected agent centre
+
+    @classmethod
+    def of(cls, cfg: Mapping[str, Any]) -> "Walk":
+        """From the config's ``evaluate.walk`` section."""
+        return cls(**{k: float(v) for k, v in cfg.items()})
 
 
 def walk_grid(room: RoomInput, cell: float, clearance: float) -> tuple[np.ndarray, float, np.ndarray]:
@@ -65,19 +82,19 @@ def connected_share(agent: np.ndarray, connected: np.ndarray) -> float:
     return float(connected.sum() / agent.sum()) if agent.any() else 0.0
 
 
-def walkable_share(room: RoomInput, cfg: dict[str, Any]) -> float:
-    """The door-connected share of the agent's free space alone (``cfg``: the ``evaluate.walk`` settings)."""
-    free, cell, centre = walk_grid(room, cfg["cell"], cfg["clearance"])
-    return connected_share(*door_connected(free, room, cell, centre, cfg["robot_radius"], cfg["door_reach"]))
+def walkable_share(room: RoomInput, walk: Walk) -> float:
+    """The door-connected share of the agent's free space alone."""
+    free, cell, centre = walk_grid(room, walk.cell, walk.clearance)
+    return connected_share(*door_connected(free, room, cell, centre, walk.robot_radius, walk.door_reach))
 
 
-def walkability(room: RoomInput, cfg: dict[str, Any]) -> dict[str, Any]:
+def walkability(room: RoomInput, walk: Walk) -> dict[str, Any]:
     """``walkable_share``: door-connected share of the agent's free space; ``reachable``: share of floor objects
     whose front midpoint lies within ``front_reach`` of a door-connected agent centre; ``all_reachable``."""
-    free, cell, centre = walk_grid(room, cfg["cell"], cfg["clearance"])
-    agent, connected = door_connected(free, room, cell, centre, cfg["robot_radius"], cfg["door_reach"])
+    free, cell, centre = walk_grid(room, walk.cell, walk.clearance)
+    agent, connected = door_connected(free, room, cell, centre, walk.robot_radius, walk.door_reach)
     share = connected_share(agent, connected)
-    idx, fronts = front_points(room, cfg["clearance"])
+    idx, fronts = front_points(room, walk.clearance)
     if not connected.any() or not len(idx):
         ok = np.zeros(len(idx), bool)
     else:
@@ -85,6 +102,6 @@ def walkability(room: RoomInput, cfg: dict[str, Any]) -> dict[str, Any]:
         xs, ys = pixel_centres(free.shape[0], cell, centre)
         col = np.clip(np.round((fronts[:, 0] - xs[0]) / cell).astype(int), 0, free.shape[1] - 1)
         row = np.clip(np.round((ys[0] - fronts[:, 1]) / cell).astype(int), 0, free.shape[0] - 1)
-        ok = dist[row, col] <= cfg["front_reach"]
+        ok = dist[row, col] <= walk.front_reach
     return {"walkable_share": share, "reachable": float(ok.mean()) if len(ok) else 1.0,
             "all_reachable": bool(ok.all())}

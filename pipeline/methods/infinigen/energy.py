@@ -12,7 +12,7 @@ from ...geometry import boxes as gb
 from ...geometry.polygon import nearest_segment
 from ...placement.checks import AREA_EPS
 from ...placement.retrieval import ModelPool
-from ...room.walkability import walkability
+from ...room.walkability import Walk, walkability
 from ..solver import operators as op
 from ..solver.moves import Spec
 from ..solver.state import State, wall_yaw
@@ -122,14 +122,14 @@ def symmetry(program: Program, state: State) -> float:
     return total
 
 
-def free_floor(cfg: dict, state: State) -> float:
-    """1 - the walkable share of the evaluation's walkability measure (``cfg``: its settings, a coarser cell)."""
-    return 1.0 - walkability(state.as_room(), cfg)["walkable_share"] if state.items else 0.0
+def free_floor(walk: Walk, state: State) -> float:
+    """1 - the walkable share of the evaluation's walkability measure (``walk``: its settings, a coarser cell)."""
+    return 1.0 - walkability(state.as_room(), walk)["walkable_share"] if state.items else 0.0
 
 
-def terms_of(program: Program, reach: float, walk_cfg: dict) -> list[Term]:
+def terms_of(program: Program, reach: float, walk: Walk) -> list[Term]:
     """The program's weighted soft terms."""
     fns = {"next_to": partial(next_to, program), "facing": partial(facing, program),
            "accessibility": partial(accessibility, reach), "alignment": alignment,
-           "symmetry": partial(symmetry, program), "free_floor": partial(free_floor, walk_cfg)}
+           "symmetry": partial(symmetry, program), "free_floor": partial(free_floor, walk)}
     return [Term(name, float(program.weights.get(name, 0.0)), fn) for name, fn in fns.items()]

@@ -10,6 +10,7 @@ from typing import Iterator
 import numpy as np
 
 from ...errors import InputError
+from ...room.walkability import Walk
 from ..interface import Scene, Task
 from ..placing import load_context
 from ..solver.anneal import solve
@@ -42,7 +43,7 @@ class InfinigenLayout:
         missing = sorted(set(program.objects) - set(specs))
         if missing:
             log.warning("%s: no training instance of %s: left out of the program", task.program, ", ".join(missing))
-        walk = {**self.config["evaluate"]["walk"], "cell": self.cfg["free_floor_cell"]}
+        walk = replace(Walk.of(self.config["evaluate"]["walk"]), cell=self.cfg["free_floor_cell"])
         solver_cfg = {"schedule": self.cfg["schedule"], "moves": self.cfg["moves"],
                       "steps": self.cfg["presets"][self.cfg["preset"]]}
 
