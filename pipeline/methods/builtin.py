@@ -92,7 +92,7 @@ BUILTIN = [
                                       "grains.resolve", *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
            description="GRAINS: hierarchies decoded from a recursive VAE's prior, each wall group laid onto a held-out "
-           "room's wall, models retrieved by size, colliding floor objects moved apart (grains.resolve)"),
+           "room's wall, models retrieved by size, colliding floor objects moved apart and off the doors' zones (grains.resolve)"),
     Method("grains_decoded", "pipeline.methods.grains.layout:GrainsDecoded", model="grains",
            keys=lambda config, name: ["seed", "grains.scenes", "grains.max_depth", "grains.snap", *CONTEXT_KEYS],
            scenes=lambda config, name: config["grains"]["scenes"],
