@@ -220,7 +220,8 @@ SCHEMAS["scenes"] = pa.schema([
     _f("insertions", _I32, doc="accepted placements, those undone by backtracking included"),
     _f("rejections", _I32, doc="candidates that failed a check"), _f("backtracks", _I32),
     _f("attempts", _I32, doc="searches from scratch: 1 + the restarts used (instantiate.restarts); the counts add up over them"),
-    _f("failures", _STR, doc="JSON: rejections per check (outside, overhangs, collides, violates)"),
+    _f("failures", _STR, doc="JSON: rejections per check, by the refusal's first word (outside, blocks: a door's zone, "
+       "overhangs, violates, leaves: a planned wall, collides, closes: the floor off from the door, forecloses, nowhere)"),
     _f("drops", _STR, doc="JSON: per object a partial scene left out, its id, category, cause ('no_place': budget "
        "spent, 'no_model': no training instance, 'no_span': a wall-bound object planned against two facing walls "
        "no instance spans, 'support_dropped', 'overlap': GRAINS's repair could not clear it) and, for no_place, "
