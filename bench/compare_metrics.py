@@ -28,9 +28,9 @@ def load(run: Path) -> dict[str, dict]:
 def figure(entry: dict, name: str) -> tuple[float, tuple[float, float] | None]:
     """A method's figure and its 95% interval (None when the run has none)."""
     if name == "sca":
-        sca = entry.get("sca") or {}
-        ci = (sca["low"], sca["high"]) if "low" in sca else None
-        return float(sca.get("accuracy", float("nan"))), ci
+        sca = entry.get("sca") or {}  # a set too small for the classifier holds no accuracy
+        ci = (sca["low"], sca["high"]) if sca.get("low") is not None else None
+        return float("nan") if sca.get("accuracy") is None else float(sca["accuracy"]), ci
     ci = (entry.get("intervals") or {}).get(name)
     ci = ci if ci and None not in ci else None
     value = entry.get(name)
