@@ -410,7 +410,7 @@ def _emit_spatial_edges(g, room_id: str, seen: dict, contained, layer: PlanLayer
     best = dict(zip(unique_pairs.tolist(), cand[first].tolist()))
     for a, t in contained:
         best.setdefault(a * total + t, -1)
-    labels = relations.distance_labels(seen["gap"], np.maximum(diag[a_], diag[t_]), cfg["distance"])
+    labels = relations.distance_labels(seen["gap"], np.maximum(diag[a_], diag[t_]), relations.DistanceBands.of(cfg["distance"]))
     for pair in sorted(best):
         a, t = divmod(pair, total)
         i = best[pair]

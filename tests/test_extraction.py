@@ -11,7 +11,7 @@ from pipeline.geometry import relations
 
 from conftest import Room, default_config, edge, l_sofa_mesh, table_mesh
 
-DIST = default_config()["extract"]["distance"]
+DIST = relations.DistanceBands.of(default_config()["extract"]["distance"])
 
 
 def bedroom():

@@ -6,6 +6,7 @@ visibility sweep's pieces and per-target visibility.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any, TypeVar, cast
 
 import numpy as np
@@ -17,22 +18,38 @@ DISTANCES = ("adjacent", "proximal", "distant")
 T = TypeVar("T")
 
 
-def distance_thresholds(max_diag: ArrayLike, cfg: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class DistanceBands:
+    """Extraction's distance labels (``extract.distance``, paper section 4.3): a gap is adjacent up to the smaller of
+    ``adjacent_abs`` m and ``adjacent_rel`` of the larger footprint diagonal, proximal up to the larger of
+    ``proximal_abs`` m and ``proximal_rel`` of it, distant beyond."""
+    adjacent_abs: float
+    adjacent_rel: float
+    proximal_abs: float
+    proximal_rel: float
+
+    @classmethod
+    def of(cls, cfg: Mapping[str, Any]) -> "DistanceBands":
+        """From the config's ``extract.distance`` section."""
+        return cls(**{k: float(v) for k, v in cfg.items()})
+
+
+def distance_thresholds(max_diag: ArrayLike, bands: DistanceBands) -> tuple[np.ndarray, np.ndarray]:
     """The largest gaps (m) labelled adjacent and proximal (:func:`distance_labels`) between objects whose larger
     footprint diagonal is ``max_diag`` (scalar or array; the result broadcasts alike)."""
     max_diag = np.asarray(max_diag, float)
-    return (np.minimum(cfg["adjacent_abs"], cfg["adjacent_rel"] * max_diag),
-            np.maximum(cfg["proximal_abs"], cfg["proximal_rel"] * max_diag))
+    return (np.minimum(bands.adjacent_abs, bands.adjacent_rel * max_diag),
+            np.maximum(bands.proximal_abs, bands.proximal_rel * max_diag))
 
 
-def distance_labels(gap: ArrayLike, max_diag: ArrayLike, cfg: Mapping[str, Any]) -> np.ndarray:
+def distance_labels(gap: ArrayLike, max_diag: ArrayLike, bands: DistanceBands) -> np.ndarray:
     """adjacent / proximal / distant for gaps (m) between objects whose larger footprint diagonal is ``max_diag``.
 
     adjacent: gap <= min(adjacent_abs, adjacent_rel * max_diag); proximal: gap <= max(proximal_abs,
     proximal_rel * max_diag); distant otherwise (paper §4.3).
     """
     gap, max_diag = np.broadcast_arrays(np.asarray(gap, float), np.asarray(max_diag, float))
-    adj, prox = distance_thresholds(max_diag, cfg)
+    adj, prox = distance_thresholds(max_diag, bands)
     return np.where(gap <= adj, "adjacent", np.where(gap <= prox, "proximal", "distant"))
 
 

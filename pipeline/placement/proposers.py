@@ -15,7 +15,7 @@ from ..geometry.boxes import SIDES, diagonal_2d, point_box
 from ..geometry.frames import front_of, to_local, to_world, turn_error, wrap
 from ..geometry.function import faces_wall, facing_angles, facing_each_other, facing_turn, in_front
 from ..geometry.polygon import nearest_segment
-from ..geometry.relations import distance_thresholds
+from ..geometry.relations import DistanceBands, distance_thresholds
 from ..room import RoomInput, Walls
 from .anchors import SUPPORT, Anchor
 from .facing import AnchorFacing
@@ -114,7 +114,7 @@ def gap_thresholds(a: Anchor, room: RoomInput, walls: Walls, extract: dict) -> t
     the two (a wall's is the object's)."""
     anchor_diag = 0.0 if a.wall is not None else float(diagonal_2d(*room.boxes[a.obj, 3:5]))
     diag = max(anchor_diag, float(diagonal_2d(*a.target_half)))
-    adj, prox = distance_thresholds(diag, extract["distance"])
+    adj, prox = distance_thresholds(diag, DistanceBands.of(extract["distance"]))
     return float(adj), float(prox)
 
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..geometry.boxes import diagonal_2d, on_floor
 from ..geometry.function import back_to_wall
-from ..geometry.relations import distance_thresholds
+from ..geometry.relations import DistanceBands, distance_thresholds
 from ..room import RoomInput, Walls
 
 PARALLEL_COS = 0.999  # two walls whose inner normals' dot product is below minus this face each other (2.6 degrees)
@@ -63,7 +63,7 @@ def unspanned(walls: Walls, wall_ids: list[str], halves: np.ndarray, distance: d
     halves = np.asarray(halves, float).reshape(-1, 2)
     longest = diagonal_2d(halves[:, 0], halves[:, 1])
     shortest = 2 * halves.min(1)
-    adjacent = distance_thresholds(longest, distance)[0]
+    adjacent = distance_thresholds(longest, DistanceBands.of(distance))[0]
     index = [walls.ids.index(w) for w in wall_ids if w in walls.ids]
     for i, j in combinations(index, 2):
         if walls.normal[i] @ walls.normal[j] > -PARALLEL_COS:
