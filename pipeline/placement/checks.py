@@ -13,8 +13,8 @@ import shapely
 from ..extraction import extract_room
 from ..geometry import boxes
 from ..geometry.collision import CollisionTest, deepest_penetration
-from ..geometry.polygon import door_zones, outside_area
-from ..room import RoomInput
+from ..geometry.polygon import outside_area
+from ..room import RoomInput, door_zones_of
 from .plan import PlanEdge
 from .walkable import FloorKept
 
@@ -144,10 +144,9 @@ def found_edges(edges: list[dict]) -> dict:
 def blocks_door(room: RoomInput, corners: np.ndarray, depth: float) -> bool:
     """Whether a floor footprint ``corners (4, 2)`` covers more than 1 cm^2 of the zone ``depth`` m deep inside any
     door of the room (0: no zone)."""
-    doors = [o for o in room.openings if o["kind"] == "door"]
-    if depth <= 0 or not doors:
+    zones = door_zones_of(room, depth)
+    if not len(zones):
         return False
-    zones = door_zones(room.outline, np.array([[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in doors]), depth)
     overlap = shapely.area(shapely.intersection(shapely.polygons(zones), shapely.Polygon(corners)))
     return bool((overlap > AREA_EPS).any())
 

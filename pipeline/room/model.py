@@ -7,7 +7,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..geometry.polygon import inward_normals, merge_collinear, outline_from_loop, signed_area, wall_loop
+from ..geometry.polygon import door_zones, inward_normals, merge_collinear, outline_from_loop, signed_area, wall_loop
 
 BOX_COLUMNS = ["cx", "cy", "cz", "hx", "hy", "hz", "yaw"]
 POSE_COLUMNS = ["px", "py", "pz", "yaw", "sx", "sy", "sz"]
@@ -29,6 +29,22 @@ class RoomInput:
     model_ids: list[str]
     boxes: np.ndarray  # (n, 7) BOX_COLUMNS
     poses: np.ndarray  # (n, 7) POSE_COLUMNS
+
+
+def door_segments(room: RoomInput) -> np.ndarray:
+    """``(d, 2, 2)`` the floor-plan segments of the room's doors (its openings of kind ``door``)."""
+    doors = [[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in room.openings if o["kind"] == "door"]
+    return np.array(doors, float).reshape(-1, 2, 2)
+
+
+def door_zones_of(room: RoomInput, depth: float) -> np.ndarray:
+    """``(d, 4, 2)`` the rectangles reaching ``depth`` m into the room from each of its doors
+    (:func:`~pipeline.geometry.polygon.door_zones`); none when ``depth`` is 0 or the room has no door. The one door
+    clearance of PlanIT's search, the annealing solvers' hard limits and GRAINS's repair."""
+    doors = door_segments(room)
+    if depth <= 0 or not len(doors):
+        return np.zeros((0, 4, 2))
+    return door_zones(room.outline, doors, depth)
 
 
 @dataclass

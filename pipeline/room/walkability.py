@@ -14,7 +14,7 @@ from scipy import ndimage
 
 from ..geometry import boxes
 from ..geometry.raster import fill_polygon, fill_quads, pixel_centres
-from .model import RoomInput
+from .model import RoomInput, door_segments
 
 
 @dataclass(frozen=True)
@@ -58,13 +58,12 @@ def door_connected(free: np.ndarray, room: RoomInput, cell: float, centre: np.nd
     if n == 0:
         return agent, agent
     xs, ys = pixel_centres(free.shape[0], cell, centre)
-    doors = [o for o in room.openings if o["kind"] == "door"]
+    doors = door_segments(room)
     seeds = set()
-    for d in doors:
-        mx, my = (d["x0"] + d["x1"]) / 2, (d["y0"] + d["y1"]) / 2
+    for mx, my in doors.mean(1):
         near = (xs[None, :] - mx) ** 2 + (ys[:, None] - my) ** 2 <= (radius + door_reach) ** 2
         seeds |= set(np.unique(labels[near & agent]).tolist())
-    if not doors:
+    if not len(doors):
         seeds = {int(np.argmax(np.bincount(labels.ravel())[1:])) + 1}
     return agent, np.isin(labels, sorted(seeds - {0}))
 

@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...geometry.boxes import clearing_moves, footprint_corners, from_corners, penetration_depths
-from ...geometry.polygon import door_zones, outside_pieces
-from ...room import RoomInput
+from ...geometry.polygon import outside_pieces
+from ...room import RoomInput, door_zones_of
 
 
 def bound(box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -48,19 +48,12 @@ def beyond(room: RoomInput, rect: tuple[float, float, float, float]) -> np.ndarr
     return from_corners(outside_pieces(room.outline, rect), 0.0, 2 * float(room.height))
 
 
-def door_zones_of(room: RoomInput, depth: float) -> np.ndarray:
-    """``(d, 7)`` the zones ``depth`` m deep inside each door of ``room`` (:func:`~pipeline.geometry.polygon.door_zones`,
-    the placement checks' door clearance) as boxes twice the room's height; none when ``depth`` is 0."""
-    doors = [[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in room.openings if o["kind"] == "door"]
-    if depth <= 0 or not doors:
-        return np.zeros((0, 7))
-    return from_corners(door_zones(room.outline, np.array(doors, float), depth), 0.0, 2 * float(room.height))
-
-
 def kept_clear(room: RoomInput, rect: tuple[float, float, float, float], door_clearance: float) -> np.ndarray:
     """``(m, 7)`` what :func:`separated` keeps objects off: the parts of ``rect`` outside the room (:func:`beyond`) and
-    the zones ``door_clearance`` m deep inside its doors (:func:`door_zones_of`; 0: none)."""
-    return np.vstack([beyond(room, rect), door_zones_of(room, door_clearance)])
+    the zones ``door_clearance`` m deep inside its doors (:func:`~pipeline.room.door_zones_of`, the placement checks'
+    door clearance; 0: none), as boxes twice the room's height."""
+    doors = from_corners(door_zones_of(room, door_clearance), 0.0, 2 * float(room.height))
+    return np.vstack([beyond(room, rect), doors])
 
 
 def depths(kept: np.ndarray, box: np.ndarray) -> np.ndarray:

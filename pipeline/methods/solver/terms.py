@@ -13,8 +13,9 @@ import shapely
 
 from ...geometry import boxes as gb
 from ...geometry.function import footprint_gaps
-from ...geometry.polygon import door_zones, outside_area
+from ...geometry.polygon import outside_area
 from ...placement.checks import AREA_EPS, required_support, support_shares
+from ...room import door_zones_of
 from .state import State
 
 HARD = ("collision", "outside", "door", "overhang")
@@ -70,9 +71,7 @@ class Hard:
 
     def __init__(self, state: State, limits: Limits):
         self.limits = limits
-        doors = [o for o in state.room.openings if o["kind"] == "door"]
-        quads = door_zones(state.room.outline, np.array([[[o["x0"], o["y0"]], [o["x1"], o["y1"]]] for o in doors]),
-                           limits.door) if doors and limits.door > 0 else np.zeros((0, 4, 2))
+        quads = door_zones_of(state.room, limits.door)
         self.zones = shapely.union_all(shapely.polygons(quads)) if len(quads) else None
 
     def total(self, state: State) -> int:
