@@ -71,3 +71,6 @@ def test_the_least_share_is_the_training_rooms_quantile():
     assert FloorKept.learn([], walk, settings) is None
     no_door = replace(rooms[1], openings=[])  # no door: the largest free component stands in for the door's
     assert walkable_share(no_door, WALK) > 0.6
+    # rooms without a door (AI2-THOR's) teach no least share, and a room without one is never refused
+    assert FloorKept.learn([no_door, replace(rooms[0], openings=[])], walk, settings) is None
+    assert FloorKept(WALK, 0.99, 0.01).closes(no_door, 1) is None and FloorKept(WALK, 0.99, 0.01).closes(rooms[1], 1)

@@ -10,13 +10,14 @@ from typing import Any
 
 import numpy as np
 
-from ..room import RoomInput
+from ..room import RoomInput, door_segments
 from ..room.walkability import Walk, walkable_share
 
 
 def learn_walkable_floor(rooms: list[RoomInput], walk: Walk, quantile: float) -> float:
-    """The ``quantile`` of the training ``rooms``' walkable shares; 0 (no check) when no room has a floor."""
-    shares = [walkable_share(r, walk) for r in rooms if len(r.outline) >= 3]
+    """The ``quantile`` of the walkable shares of the training ``rooms`` that have a door; 0 (no check) when none has
+    (AI2-THOR's rooms: the share would only say how whole the floor is, and such rooms keep 99% of it whole)."""
+    shares = [walkable_share(r, walk) for r in rooms if len(r.outline) >= 3 and len(door_segments(r))]
     return round(float(np.quantile(shares, quantile)), 3) if shares else 0.0
 
 
@@ -39,7 +40,9 @@ class FloorKept:
     def closes(self, room: RoomInput, k: int) -> tuple[float, float] | None:
         """``(share before, share after)`` when floor object ``k`` of ``room`` leaves the walkable share under
         ``least`` and more than ``tolerance`` under what it was without the object; else None (a room already under
-        ``least`` may still take objects that do not make it worse)."""
+        ``least`` may still take objects that do not make it worse; a room with no door is not checked)."""
+        if not len(door_segments(room)):
+            return None
         after = walkable_share(room, self.walk)
         if after >= self.least:
             return None
