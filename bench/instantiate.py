@@ -171,6 +171,7 @@ def main() -> None:
             colliding += int(evaluation_collisions(out.room, dict(zip(plan.ids, plan.parent)), ctx.checker, ev).sum())
     placed = [r for r in rows if r[0]]
     walk = Walk.of(cfg["evaluate"]["walk"])
+    shares = np.array([walkable_share(r, walk) for r in rooms])  # each placed room's, once
     axis = off_axis_shares(rooms, sym, cfg["evaluate"]["off_axis_angle"])
     train_axis = off_axis_shares(ctx.corpus.training(), sym, cfg["evaluate"]["off_axis_angle"])
     result = {"room_type": args.room_type, "location": args.location, "graphs": args.graphs, "scenes": len(rows),
@@ -187,8 +188,8 @@ def main() -> None:
               "functional_placed": {k: round(float(v), 3) for k, v in
                                     pd.DataFrame(functional).mean().items()} if functional else None,
               **selection(ctx.corpus, plans[:len(rows)], rooms),
-              "walkable_share": round(float(np.mean([walkable_share(r, walk) for r in rooms])), 4) if rooms else None,
-              "walkable_under_0.8": sum(walkable_share(r, walk) < 0.8 for r in rooms),
+              "walkable_share": round(float(np.mean(shares)), 4) if rooms else None,
+              "walkable_under_0.8": int((shares < 0.8).sum()),
               "off_axis_share": axis["all"], "off_axis_share_training": train_axis["all"],
               "off_axis_gap": off_axis_gap(axis, train_axis, cfg["evaluate"]["off_axis_min_objects"]),
               **(probe_networks(cfg, args.room_type, saved, args.probes, ctx.checker) if args.location != "prior" else {}),

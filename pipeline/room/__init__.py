@@ -4,5 +4,4 @@ from .load import load_rooms, room_inputs, room_slices
 from .model import BOX_COLUMNS, POSE_COLUMNS, RoomInput, Walls, door_segments, door_zones_of, merge_walls, wall_footprints
 
 __all__ = ["BOX_COLUMNS", "POSE_COLUMNS", "RoomInput", "Walls", "door_segments", "door_zones_of", "merge_walls",
-           "wall_footprints", "load_rooms",
-           "room_inputs", "room_slices"]
+           "wall_footprints", "load_rooms", "room_inputs", "room_slices"]

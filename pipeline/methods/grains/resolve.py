@@ -42,18 +42,17 @@ def inside_move(box: np.ndarray, rect: tuple[float, float, float, float]) -> np.
     return np.where(fits, np.maximum(rlo - lo, 0.0) - np.maximum(hi - rhi, 0.0), (rlo + rhi - lo - hi) / 2)
 
 
-def beyond(room: RoomInput, rect: tuple[float, float, float, float]) -> np.ndarray:
-    """``(m, 7)`` the parts of ``rect`` outside the room as boxes twice the room's height
-    (:func:`~pipeline.geometry.polygon.outside_pieces`): what :func:`separated` keeps objects off."""
-    return from_corners(outside_pieces(room.outline, rect), 0.0, 2 * float(room.height))
-
-
 def kept_clear(room: RoomInput, rect: tuple[float, float, float, float], door_clearance: float) -> np.ndarray:
-    """``(m, 7)`` what :func:`separated` keeps objects off: the parts of ``rect`` outside the room (:func:`beyond`) and
-    the zones ``door_clearance`` m deep inside its doors (:func:`~pipeline.room.door_zones_of`, the placement checks'
-    door clearance; 0: none), as boxes twice the room's height."""
-    doors = from_corners(door_zones_of(room, door_clearance), 0.0, 2 * float(room.height))
-    return np.vstack([beyond(room, rect), doors])
+    """``(m, 7)`` what :func:`separated` keeps objects off, as boxes twice the room's height: the parts of ``rect``
+    outside the room (:func:`~pipeline.geometry.polygon.outside_pieces`) and the zones ``door_clearance`` m deep inside
+    its doors (:func:`~pipeline.room.door_zones_of`, the placement checks' door clearance; 0: none)."""
+    pieces = np.concatenate([outside_pieces(room.outline, rect).reshape(-1, 4, 2), door_zones_of(room, door_clearance)])
+    return from_corners(pieces, 0.0, 2 * float(room.height))
+
+
+def beyond(room: RoomInput, rect: tuple[float, float, float, float]) -> np.ndarray:
+    """``(m, 7)`` the parts of ``rect`` outside the room alone (:func:`kept_clear` with no door zones)."""
+    return kept_clear(room, rect, 0.0)
 
 
 def depths(kept: np.ndarray, box: np.ndarray) -> np.ndarray:
