@@ -74,3 +74,14 @@ def test_the_least_share_is_the_training_rooms_quantile():
     # rooms without a door (AI2-THOR's) teach no least share, and a room without one is never refused
     assert FloorKept.learn([no_door, replace(rooms[0], openings=[])], walk, settings) is None
     assert FloorKept(WALK, 0.99, 0.01).closes(no_door, 1) is None and FloorKept(WALK, 0.99, 0.01).closes(rooms[1], 1)
+
+
+def test_a_turned_bench_closes_the_gap_only_when_the_agent_cannot_pass_it():
+    """Turned 10 degrees just beyond the sofa's end, a bench 1.0 m long spans the 1.05 m between the left wall and the
+    sofa's side with under 2 cm to spare (narrower than the 0.3 m agent) and walls the door's pocket in: refused;
+    0.4 m long it leaves over 0.3 m either side: kept."""
+    kept = FloorKept(WALK, 0.8, 0.01)
+    for length, refused in ((1.0, True), (0.4, False)):
+        r = pocket_room(None).add("bench", "bench", (length, 0.3, 0.45), (0.525, 2.4), yaw_deg=10.0)
+        closed = kept.closes(r.room_input(), 1)
+        assert (closed is not None) == refused, (length, closed)
